@@ -1,0 +1,1 @@
+"""TAVIS benchmark in MuJoCo."""

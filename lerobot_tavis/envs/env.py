@@ -1,0 +1,192 @@
+"""TavisEnv: one TAVIS task on one robot as a gymnasium env, stepped at 20 Hz.
+
+The simulator and renderer are built lazily on the first reset, so the env can be constructed in one process and
+used in another (LeRobot's forkserver vector envs). All randomness comes from the generator seeded in
+`reset(seed=...)`: the same seed and the same actions give the same observations, pixels included.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs import physics
+from lerobot_tavis.envs.control import Controller
+from lerobot_tavis.envs.modes import mode_cameras, neck_locked
+from lerobot_tavis.envs.placement import body_speed
+from lerobot_tavis.envs.rendering import CameraRig
+from lerobot_tavis.envs.robots import make_robot
+from lerobot_tavis.envs.tasks import make_task
+from lerobot_tavis.envs.tasks.catalog import task_info
+from lerobot_tavis.envs.world import World, build_world
+
+SETTLE_MAX_S = 1.5
+SETTLE_MIN_S = 0.1
+SETTLE_SPEED_M_S = 0.005
+
+
+class _Sim:
+    """Model, data, controller and renderer of one env; exists between the first reset and close()."""
+
+    def __init__(self, world: World, camera_mode: str, image_size, blacked_out):
+        self.world = world
+        self.model = world.model
+        self.data = mujoco.MjData(world.model)
+        self.controller = Controller(world, neck_locked=neck_locked(camera_mode))
+        cameras = {name: world.cameras[name] for name in mode_cameras(camera_mode)}
+        self.rig = CameraRig(world.model, cameras, image_size, blacked_out)
+
+    def advance_tick(self) -> None:
+        self.controller.tick(self.data)
+        mujoco.mj_step(self.model, self.data, nstep=physics.SUBSTEPS_PER_TICK)
+
+
+class TavisEnv(gym.Env):
+    """A TAVIS task. Observations: `pixels` (the camera mode's cameras, HxWx3 uint8), `agent_pos` (the measured
+    canonical 19-D state) and `joint_pos` (robot joints, see `Robot.joint_names`). Actions: the canonical 19-D
+    action (`lerobot_tavis.canonical`); head angles and gripper values outside their ranges are clipped.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": physics.POLICY_HZ}
+
+    def __init__(self, task: str = "tabletop", robot: str = "gr1t2", camera_mode: str = "headcam",
+                 split: str = "id", image_size: tuple[int, int] = (480, 640), episode_length_s: float = 20.0,
+                 shadows: bool = False, render_mode: str | None = "rgb_array"):
+        info = task_info(task)
+        if split not in info.splits:
+            raise ValueError(f"split of task {task!r} must be one of {info.splits}, got {split!r}")
+        self.camera_names = mode_cameras(camera_mode)
+        make_robot(robot)  # validates the name; the model itself is built on the first reset
+        height, width = _check_image_size(image_size)
+        if not episode_length_s > 0:
+            raise ValueError(f"episode_length_s must be > 0, got {episode_length_s}")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode must be 'rgb_array' or None, got {render_mode!r}")
+
+        self.task = task
+        self.task_description = info.prompts[0]
+        self.robot_name = robot
+        self.camera_mode = camera_mode
+        self.split = split
+        self.image_size = (height, width)
+        self.shadows = shadows
+        self.render_mode = render_mode
+        self._max_episode_steps = int(round(episode_length_s * physics.POLICY_HZ))
+        self._task = make_task(task, "id" if split == "ood_init_pose" else split)
+        self._robot = make_robot(robot)
+        self._sim: _Sim | None = None
+        self._steps = 0
+        self._last_frames: dict[str, np.ndarray] | None = None
+
+        n_joints = len(self._robot.joint_names())
+        self.observation_space = gym.spaces.Dict({
+            "pixels": gym.spaces.Dict({
+                name: gym.spaces.Box(0, 255, (height, width, 3), np.uint8) for name in self.camera_names}),
+            "agent_pos": gym.spaces.Box(-np.inf, np.inf, (canonical.ACTION_DIM,), np.float32),
+            "joint_pos": gym.spaces.Box(-np.inf, np.inf, (n_joints,), np.float32),
+        })
+        self.action_space = _action_space(self._robot.neck_range_rad())
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        sim = self._ensure_sim()
+        mujoco.mj_resetData(sim.model, sim.data)
+        sim.controller.reset(sim.data)
+        self._task.initialize_episode(sim.model, sim.data, self.np_random)
+        self.task_description = self._task.prompt
+        mujoco.mj_forward(sim.model, sim.data)
+        self._settle(sim)
+        self._steps = 0
+        return self._observe(sim), {"is_success": False}
+
+    def step(self, action):
+        sim = self._require_sim()
+        applied = sim.controller.set_command(action)
+        for _ in range(physics.TICKS_PER_STEP):
+            sim.advance_tick()
+        self._steps += 1
+        self._task.after_step(sim.model, sim.data, self._steps)
+        success = bool(self._task.is_success(sim.data))
+        truncated = self._steps >= self._max_episode_steps and not success
+        info = {"is_success": success, "applied_action": applied}
+        return self._observe(sim), float(success), success, truncated, info
+
+    def render(self) -> np.ndarray:
+        """The last observation's camera images side by side, without rendering again."""
+        if self._last_frames is None:
+            raise RuntimeError("render() needs an observation: call reset() first")
+        return np.concatenate([self._last_frames[name] for name in self.camera_names], axis=1)
+
+    def close(self) -> None:
+        if self._sim is not None:
+            self._sim.rig.close()
+            self._sim = None
+        self._last_frames = None
+
+    @property
+    def model(self) -> mujoco.MjModel:
+        return self._require_sim().model
+
+    @property
+    def data(self) -> mujoco.MjData:
+        return self._require_sim().data
+
+    @property
+    def world(self) -> World:
+        return self._require_sim().world
+
+    @property
+    def task_object(self):
+        """The simulating task (layout, prompt, success); experts read it."""
+        return self._task
+
+    def _ensure_sim(self) -> _Sim:
+        if self._sim is None:
+            world = build_world(self._robot, self._task, image_size=self.image_size, shadows=self.shadows)
+            self._sim = _Sim(world, self.camera_mode, self.image_size, self._task.blacked_out_cameras)
+        return self._sim
+
+    def _require_sim(self) -> _Sim:
+        if self._sim is None:
+            raise RuntimeError("the simulator starts on the first reset(): call reset() first")
+        return self._sim
+
+    def _settle(self, sim: _Sim) -> None:
+        """Hold the rest command until the task's props are still (at most SETTLE_MAX_S of simulated time)."""
+        props = self._task.props()
+        for tick in range(int(SETTLE_MAX_S * physics.CONTROL_HZ)):
+            sim.advance_tick()
+            if tick + 1 >= SETTLE_MIN_S * physics.CONTROL_HZ and all(
+                    body_speed(sim.model, sim.data, p) < SETTLE_SPEED_M_S for p in props):
+                break
+
+    def _observe(self, sim: _Sim) -> dict:
+        self._last_frames = sim.rig.render(sim.data)
+        return {
+            "pixels": dict(self._last_frames),
+            "agent_pos": sim.controller.measured_state(sim.data).astype(np.float32),
+            "joint_pos": sim.data.qpos[sim.world.robot_joint_qpos].astype(np.float32),
+        }
+
+
+def _check_image_size(image_size) -> tuple[int, int]:
+    try:
+        height, width = (int(v) for v in image_size)
+    except (TypeError, ValueError):
+        raise ValueError(f"image_size must be (height, width), got {image_size!r}") from None
+    if not (16 <= height <= 4096 and 16 <= width <= 4096):
+        raise ValueError(f"image_size must be within 16..4096 pixels per side, got {image_size!r}")
+    return height, width
+
+
+def _action_space(neck_range: np.ndarray) -> gym.spaces.Box:
+    """Bounds of the canonical action: hand positions within 1.5 m of the hip, unit quaternions, neck joint
+    ranges, grippers in [-1, 1]. Values outside are still accepted (see TavisEnv)."""
+    low = np.full(canonical.ACTION_DIM, -1.0)
+    high = np.full(canonical.ACTION_DIM, 1.0)
+    for arm in canonical.ARMS:
+        low[arm.position], high[arm.position] = -1.5, 1.5
+    low[canonical.HEAD], high[canonical.HEAD] = neck_range[:, 0], neck_range[:, 1]
+    return gym.spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)

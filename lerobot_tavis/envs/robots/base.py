@@ -1,0 +1,93 @@
+"""What every embodiment provides: a standalone MjSpec of the robot plus the facts the controller needs.
+
+A robot spec holds only the robot, its base already at its world pose, with unprefixed names
+(`left_shoulder_pitch`, `left_ee`, `head`, ...). The world attaches it under the prefix `<robot name>/`; the IK
+controller compiles it alone, so both models share world coordinates.
+"""
+
+from __future__ import annotations
+
+import abc
+from typing import ClassVar
+
+import mujoco
+import numpy as np
+
+from lerobot_tavis.envs import physics
+from lerobot_tavis.envs.robots.calibration import RestCalibration, calibrate
+from lerobot_tavis.envs.robots.parts import GripperGeometry, JointDef
+from lerobot_tavis.envs.transforms import quat_multiply
+
+
+class Robot(abc.ABC):
+    """A fixed-base humanoid torso with two 7-DoF arms, a 3-DoF neck, two parallel grippers and three cameras."""
+
+    name: ClassVar[str]
+    canonical_origin: ClassVar[tuple[float, float, float]]  # world position of the canonical (hip) frame
+    rest_posture_seed: ClassVar[dict[str, tuple[float, ...]]]  # seeds the rest calibration (calibration.py)
+    gripper: ClassVar[GripperGeometry]
+    SIDES: ClassVar[tuple[str, str]] = ("left", "right")
+    CAMERAS: ClassVar[tuple[str, ...]] = ("head", "left_wrist", "right_wrist")
+
+    @abc.abstractmethod
+    def arm_joints(self, side: str) -> tuple[JointDef, ...]:
+        """The arm's seven joints from shoulder to wrist, in the robot's official order."""
+
+    @abc.abstractmethod
+    def neck_joints(self) -> tuple[JointDef, JointDef, JointDef]:
+        """Neck roll, pitch and yaw, in that order."""
+
+    @abc.abstractmethod
+    def _build(self, spec: mujoco.MjSpec) -> None:
+        """Add the robot's bodies, joints, actuators, sites (`<side>_ee` at the wrist centre with the hand frame's
+        orientation, `<side>_grasp`) and cameras to `spec`."""
+
+    def raw_spec(self) -> mujoco.MjSpec:
+        """The robot with its end-effector sites still aligned with the hand frames (input of the calibration)."""
+        spec = mujoco.MjSpec()
+        spec.modelname = self.name
+        physics.configure_compiler(spec)
+        self._build(spec)
+        return spec
+
+    def build_spec(self) -> mujoco.MjSpec:
+        """The robot with calibrated end-effector frames: the rest quaternion is the relaxed rest orientation."""
+        spec = self.raw_spec()
+        for side, quat in self.calibration().ee_quat_in_hand.items():
+            spec.site(self.ee_site(side)).quat = quat
+        return spec
+
+    def calibration(self) -> RestCalibration:
+        return calibrate(type(self))
+
+    def ee_quat_for_hand(self, side: str, hand_quat) -> np.ndarray:
+        """End-effector quaternion to command for a desired hand-frame orientation (both world frame, w, x, y, z).
+
+        Example: `hand_quat = (1, 0, 0, 0)` points the gripper straight down with the fingers closing along y.
+        """
+        return quat_multiply(hand_quat, self.calibration().ee_quat_in_hand[side])
+
+    @property
+    def prefix(self) -> str:
+        return f"{self.name}/"
+
+    def arm_joint_names(self, side: str) -> tuple[str, ...]:
+        return tuple(j.name for j in self.arm_joints(side))
+
+    def neck_joint_names(self) -> tuple[str, str, str]:
+        return tuple(j.name for j in self.neck_joints())
+
+    def neck_range_rad(self) -> np.ndarray:
+        """(3, 2) array of neck roll/pitch/yaw limits."""
+        return np.array([j.range_rad for j in self.neck_joints()])
+
+    def ee_site(self, side: str) -> str:
+        return f"{side}_ee"
+
+    def grasp_site(self, side: str) -> str:
+        return f"{side}_grasp"
+
+    def joint_names(self) -> tuple[str, ...]:
+        """The joints reported in `joint_pos`: left arm, right arm, neck, then one opening per gripper."""
+        return (*self.arm_joint_names("left"), *self.arm_joint_names("right"), *self.neck_joint_names(),
+                "left_finger_a", "right_finger_a")

@@ -1,0 +1,34 @@
+"""Sandbox scene: the five YCB objects standing in a row on the table; there is nothing to succeed at."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from lerobot_tavis.envs import placement
+from lerobot_tavis.envs.objects import OBJECT_NAMES, YCB_OBJECTS, add_prop
+from lerobot_tavis.envs.tasks.base import Task
+from lerobot_tavis.envs.tasks.catalog import TASKS
+
+ROW_X = 0.42
+ROW_Y = np.linspace(0.24, -0.24, len(OBJECT_NAMES))
+JITTER_M = 0.02
+
+
+class Tabletop(Task):
+    info = TASKS["tabletop"]
+
+    def build(self, spec: mujoco.MjSpec) -> None:
+        for name in OBJECT_NAMES:
+            add_prop(spec, YCB_OBJECTS[name])
+
+    def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
+        for name, y in zip(OBJECT_NAMES, ROW_Y):
+            dx, dy = rng.uniform(-JITTER_M, JITTER_M, size=2)
+            placement.place_on_table(model, data, name, ROW_X + dx, y + dy, rng.uniform(-np.pi, np.pi))
+
+    def is_success(self, data) -> bool:
+        return False
+
+    def props(self) -> tuple[str, ...]:
+        return OBJECT_NAMES
