@@ -138,6 +138,10 @@ class TavisEnv(gym.Env):
         return self._require_sim().world
 
     @property
+    def controller(self) -> Controller:
+        return self._require_sim().controller
+
+    @property
     def task_object(self):
         """The simulating task (layout, prompt, success); experts read it."""
         return self._task

@@ -1,0 +1,62 @@
+"""Videos and image sheets of camera frames. Files are written to a temporary name and renamed when complete."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import av
+import cv2
+import numpy as np
+
+
+def write_mp4(path: str | Path, frames: list[np.ndarray], fps: int) -> Path:
+    """Encode RGB uint8 frames (H, W, 3; H and W even) as H.264 MP4."""
+    path = Path(path)
+    if not frames:
+        raise ValueError(f"no frames to write to {path}")
+    height, width = frames[0].shape[:2]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f".{path.name}.partial")
+    with av.open(str(partial), mode="w", format="mp4") as container:
+        stream = container.add_stream("libx264", rate=fps)
+        stream.width, stream.height, stream.pix_fmt = width, height, "yuv420p"
+        stream.options = {"crf": "20", "preset": "veryfast"}
+        for frame in frames:
+            container.mux(stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(frame), format="rgb24")))
+        container.mux(stream.encode())
+    os.replace(partial, path)
+    return path
+
+
+def label(image: np.ndarray, text: str) -> np.ndarray:
+    """A copy of `image` with `text` in its top-left corner."""
+    out = image.copy()
+    scale = max(0.4, image.shape[0] / 600)
+    cv2.putText(out, text, (8, int(22 * scale)), cv2.FONT_HERSHEY_SIMPLEX, scale, (0, 0, 0), 3, cv2.LINE_AA)
+    cv2.putText(out, text, (8, int(22 * scale)), cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), 1, cv2.LINE_AA)
+    return out
+
+
+def side_by_side(frames: dict[str, np.ndarray]) -> np.ndarray:
+    """Labelled frames of equal height in one row."""
+    return np.concatenate([label(image, name) for name, image in frames.items()], axis=1)
+
+
+def sheet(frames: dict[str, np.ndarray], columns: int = 2) -> np.ndarray:
+    """Labelled frames of equal size on a grid, row by row."""
+    images = [label(image, name) for name, image in frames.items()]
+    blank = np.zeros_like(images[0])
+    images += [blank] * (-len(images) % columns)
+    rows = [np.concatenate(images[i:i + columns], axis=1) for i in range(0, len(images), columns)]
+    return np.concatenate(rows, axis=0)
+
+
+def write_png(path: str | Path, image: np.ndarray) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f".{path.name}.partial.png")
+    if not cv2.imwrite(str(partial), image[..., ::-1]):
+        raise OSError(f"could not write {path}")
+    os.replace(partial, path)
+    return path
