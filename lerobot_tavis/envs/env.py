@@ -18,7 +18,7 @@ from lerobot_tavis.envs.modes import mode_cameras, neck_locked
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
-from lerobot_tavis.envs.tasks import make_task
+from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.tasks.catalog import task_info
 from lerobot_tavis.envs.world import World, build_world
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from lerobot_tavis.envs import physics, scene
 from lerobot_tavis.envs.robots import Robot
-from lerobot_tavis.envs.tasks import Task
+from lerobot_tavis.envs.tasks.base import Task
 
 CAMERA_NAMES = ("head", "fixed", "left_wrist", "right_wrist")
 

@@ -1,0 +1,38 @@
+# Two entry points for a fresh machine: `make demo` and `make test`. Both create .venv with Python 3.12 when
+# missing and install the package (editable, with its extras) into it.
+
+VENV := .venv
+STAMP := $(VENV)/.installed
+# python3.12 from PATH, else a pyenv-managed 3.12 (pyenv shims exist even when 3.12 is not the active version).
+PYTHON ?= $(shell for p in python3.12 $$HOME/.pyenv/versions/3.12*/bin/python3.12; do \
+	$$p -c 'import sys; assert sys.version_info[:2] == (3, 12)' 2>/dev/null && { echo $$p; break; }; done)
+export MUJOCO_GL ?= egl
+
+.PHONY: demo test setup system-deps clean
+
+setup: $(STAMP)
+
+$(STAMP): pyproject.toml
+	@test -n "$(PYTHON)" || { echo "Python 3.12 not found: install it or pass PYTHON=/path/to/python3.12"; exit 1; }
+	@$(MAKE) --no-print-directory system-deps
+	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/python -m pip install --upgrade pip
+	$(VENV)/bin/python -m pip install -e '.[dev]'
+	touch $(STAMP)
+
+# Headless OpenGL for MuJoCo (EGL on Mesa). Installed only when missing and when apt-get can run.
+system-deps:
+	@if ldconfig -p | grep -q 'libEGL.so.1' && ldconfig -p | grep -q 'libOpenGL.so.0\|libGL.so.1' \
+		&& ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1; then :; \
+	elif command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
+		apt-get update -qq && apt-get install -y -qq --no-install-recommends libegl1 libgl1-mesa-dri libopengl0; \
+	else echo "warning: EGL/Mesa libraries not found (Debian: apt-get install libegl1 libgl1-mesa-dri libopengl0)"; fi
+
+demo: $(STAMP)
+	$(VENV)/bin/tavis demo --out outputs/demo
+
+test: $(STAMP)
+	$(VENV)/bin/python -m pytest -n auto --dist loadfile -q
+
+clean:
+	rm -rf $(VENV) outputs .pytest_cache

@@ -1,0 +1,38 @@
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")  # before anything imports mujoco
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+ROBOTS = ("gr1t2", "reachy2")
+
+
+@pytest.fixture(params=ROBOTS)
+def robot_name(request) -> str:
+    return request.param
+
+
+@pytest.fixture
+def small_env():
+    """Factory for envs with tiny images (fast to render); closes them at the end of the test."""
+    from lerobot_tavis.envs.env import TavisEnv
+
+    envs = []
+
+    def make(**kwargs):
+        kwargs.setdefault("image_size", (48, 64))
+        env = TavisEnv(**kwargs)
+        envs.append(env)
+        return env
+
+    yield make
+    for env in envs:
+        env.close()
+
+
+def run_steps(env, action, steps: int):
+    obs = None
+    for _ in range(steps):
+        obs, *_ = env.step(np.asarray(action))
+    return obs

@@ -1,0 +1,129 @@
+"""TavisEnv as gymnasium and LeRobot expect it."""
+
+import pickle
+
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs.env import TavisEnv
+from tests.conftest import run_steps
+
+
+def _wiggle(steps: int = 6) -> list[np.ndarray]:
+    actions = []
+    for k in range(steps):
+        action = canonical.rest_action()
+        action[canonical.HEAD_PITCH] = 0.05 * k
+        action[canonical.LEFT.position][0] += 0.01 * k
+        actions.append(action)
+    return actions
+
+
+def _rollout(env, seed):
+    obs, _ = env.reset(seed=seed)
+    frames = [obs]
+    for action in _wiggle():
+        frames.append(env.step(action)[0])
+    return frames
+
+
+@pytest.mark.parametrize("camera_mode", ["head_wrist", "fixedcam"])
+def test_same_seed_same_episode_same_pixels(small_env, robot_name, camera_mode):
+    first = _rollout(small_env(robot=robot_name, camera_mode=camera_mode), seed=7)
+    second = _rollout(small_env(robot=robot_name, camera_mode=camera_mode), seed=7)
+    for a, b in zip(first, second):
+        for cam in a["pixels"]:
+            np.testing.assert_array_equal(a["pixels"][cam], b["pixels"][cam])
+        np.testing.assert_array_equal(a["agent_pos"], b["agent_pos"])
+        np.testing.assert_array_equal(a["joint_pos"], b["joint_pos"])
+
+
+def test_reset_with_the_same_seed_reproduces_and_another_seed_differs(small_env):
+    env = small_env(robot="gr1t2", camera_mode="fixedcam")
+    first = env.reset(seed=3)[0]["pixels"]["fixed"]
+    run_steps(env, canonical.rest_action(), 5)
+    again = env.reset(seed=3)[0]["pixels"]["fixed"]
+    other = env.reset(seed=4)[0]["pixels"]["fixed"]
+    np.testing.assert_array_equal(first, again)
+    assert not np.array_equal(first, other)
+
+
+@pytest.mark.parametrize("camera_mode,cameras", [
+    ("headcam", {"head"}), ("fixedcam", {"fixed"}),
+    ("head_wrist", {"head", "left_wrist", "right_wrist"}), ("fixed_wrist", {"fixed", "left_wrist", "right_wrist"})])
+def test_observation_holds_only_the_camera_modes_cameras(small_env, camera_mode, cameras):
+    env = small_env(robot="gr1t2", camera_mode=camera_mode, image_size=(24, 32))
+    obs, info = env.reset(seed=0)
+    assert set(obs["pixels"]) == cameras == set(env.observation_space["pixels"].spaces)
+    assert set(env._sim.rig.cameras) == cameras  # nothing else is rendered
+    for image in obs["pixels"].values():
+        assert image.shape == (24, 32, 3) and image.dtype == np.uint8
+    assert obs["agent_pos"].shape == (19,) and obs["joint_pos"].shape == (len(env.world.robot.joint_names()),)
+    assert env.observation_space.contains(obs)
+    assert info == {"is_success": False}
+
+
+def test_what_lerobot_reads(small_env):
+    env = small_env(robot="reachy2", camera_mode="headcam", episode_length_s=0.5)
+    assert env.metadata["render_fps"] == 20
+    assert env._max_episode_steps == 10
+    assert env.task == "tabletop" and isinstance(env.task_description, str) and env.task_description
+    env.reset(seed=0)
+    for step in range(10):
+        obs, reward, terminated, truncated, info = env.step(canonical.rest_action())
+        assert "is_success" in info and not terminated
+        assert truncated == (step == 9)
+
+
+def test_render_returns_the_last_frames_without_rendering_again(small_env, monkeypatch):
+    env = small_env(robot="gr1t2", camera_mode="head_wrist")
+    obs, _ = env.reset(seed=0)
+    calls = []
+    monkeypatch.setattr(env._sim.rig, "render", lambda data: calls.append(1))
+    frame = env.render()
+    assert not calls
+    np.testing.assert_array_equal(frame, np.concatenate([obs["pixels"][c] for c in env.camera_names], axis=1))
+
+
+def test_simulator_is_built_lazily_and_released_by_close():
+    env = TavisEnv(robot="gr1t2", camera_mode="fixedcam", image_size=(24, 32))
+    assert env._sim is None
+    clone = pickle.loads(pickle.dumps(env))  # what a forkserver worker receives
+    clone.reset(seed=0)
+    clone.close()
+    assert clone._sim is None
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(canonical.rest_action())
+    with pytest.raises(RuntimeError, match="reset"):
+        env.render()
+
+
+@pytest.mark.parametrize("camera_mode", ["fixedcam", "fixed_wrist"])
+def test_fixed_camera_modes_hold_the_neck_at_zero(small_env, camera_mode):
+    env = small_env(robot="gr1t2", camera_mode=camera_mode)
+    env.reset(seed=0)
+    action = canonical.rest_action()
+    action[canonical.HEAD] = (0.1, 0.6, -0.8)
+    state = run_steps(env, action, 15)["agent_pos"]
+    np.testing.assert_array_equal(state[canonical.HEAD], 0.0)
+    np.testing.assert_allclose(env.data.qpos[env.world.neck_qpos], 0.0, atol=1e-3)
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    ({"robot": "atlas"}, "robot must be one of"),
+    ({"camera_mode": "eyes"}, "camera_mode must be one of"),
+    ({"task": "fly"}, "task must be one of"),
+    ({"split": "ood_spatial"}, "split of task 'tabletop' must be one of"),
+    ({"image_size": (480,)}, "image_size must be"),
+    ({"image_size": (4, 4)}, "image_size must be within"),
+    ({"episode_length_s": 0}, "episode_length_s must be > 0"),
+])
+def test_bad_arguments_raise_clear_errors(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        TavisEnv(**kwargs)
+
+
+def test_gymnasium_env_checker(small_env):
+    check_env(small_env(robot="gr1t2", camera_mode="fixedcam", image_size=(24, 32)), skip_render_check=True)
