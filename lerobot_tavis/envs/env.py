@@ -25,6 +25,9 @@ from lerobot_tavis.envs.world import World, build_world
 SETTLE_MAX_S = 1.5
 SETTLE_MIN_S = 0.1
 SETTLE_SPEED_M_S = 0.005
+WARM_UP_STEPS = 10
+WARM_UP_POSITION_STD_M = 0.10
+WARM_UP_HEAD_STD_RAD = 0.175
 
 
 class _Sim:
@@ -98,6 +101,8 @@ class TavisEnv(gym.Env):
         self.task_description = self._task.prompt
         mujoco.mj_forward(sim.model, sim.data)
         self._settle(sim)
+        if self.split == "ood_init_pose":
+            self._warm_up(sim)
         self._steps = 0
         return self._observe(sim), {"is_success": False}
 
@@ -166,6 +171,15 @@ class TavisEnv(gym.Env):
                     body_speed(sim.model, sim.data, p) < SETTLE_SPEED_M_S for p in props):
                 break
 
+    def _warm_up(self, sim: _Sim) -> None:
+        """ood_init_pose (reference §6): hold the rest action perturbed by Gaussian noise (0.10 m per hand axis,
+        0.175 rad on head pitch and yaw, drawn from the episode's generator) for 10 policy steps. These steps
+        happen before the first observation and do not count toward the episode length."""
+        action = warm_up_action(self.np_random)
+        sim.controller.set_command(action)
+        for _ in range(WARM_UP_STEPS * physics.TICKS_PER_STEP):
+            sim.advance_tick()
+
     def _observe(self, sim: _Sim) -> dict:
         self._last_frames = sim.rig.render(sim.data)
         return {
@@ -173,6 +187,15 @@ class TavisEnv(gym.Env):
             "agent_pos": sim.controller.measured_state(sim.data).astype(np.float32),
             "joint_pos": sim.data.qpos[sim.world.robot_joint_qpos].astype(np.float32),
         }
+
+
+def warm_up_action(rng: np.random.Generator) -> np.ndarray:
+    """The perturbed rest action of the ood_init_pose warm-up (no clipping, as the reference)."""
+    action = canonical.rest_action()
+    for arm in canonical.ARMS:
+        action[arm.position] += rng.normal(0.0, WARM_UP_POSITION_STD_M, size=3)
+    action[[canonical.HEAD_PITCH, canonical.HEAD_YAW]] += rng.normal(0.0, WARM_UP_HEAD_STD_RAD, size=2)
+    return action
 
 
 def _check_image_size(image_size) -> tuple[int, int]:

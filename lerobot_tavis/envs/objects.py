@@ -7,6 +7,7 @@ collision shape is one primitive; thin visual-only bands on top give each object
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import mujoco
@@ -40,6 +41,14 @@ class PropSpec:
     @property
     def height_m(self) -> float:
         return self.size_m[-1]
+
+    def half_extent_xy(self, yaw_rad: float) -> tuple[float, float]:
+        """Half extents (m) along world x and y when standing upright, turned `yaw_rad` about z."""
+        if self.shape == "cylinder":
+            return self.size_m[0] / 2, self.size_m[0] / 2
+        hx, hy = self.size_m[0] / 2, self.size_m[1] / 2
+        c, s = abs(math.cos(yaw_rad)), abs(math.sin(yaw_rad))
+        return c * hx + s * hy, s * hx + c * hy
 
     @property
     def footprint_radius_m(self) -> float:
@@ -111,3 +120,11 @@ def _size(geom_type, half_xy: tuple[float, ...], half_height: float) -> tuple[fl
     if geom_type == mujoco.mjtGeom.mjGEOM_CYLINDER:
         return (half_xy[0], half_height, 0.0)
     return (half_xy[0], half_xy[1], half_height)
+
+
+def add_marker(spec: mujoco.MjSpec, name: str, geom_type, size, rgba) -> mujoco.MjsBody:
+    """A kinematic, visual-only body (cue card, signal light): moved per episode, touches nothing."""
+    body = spec.worldbody.add_body(name=name, mocap=True)
+    geom = body.add_geom(name=name, type=geom_type, size=size)
+    physics.style_geom(geom, physics.VISUAL, rgba)
+    return body

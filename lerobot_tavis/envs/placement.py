@@ -9,7 +9,7 @@ from lerobot_tavis.envs.objects import PROPS
 from lerobot_tavis.envs.scene import TABLE_TOP_Z
 from lerobot_tavis.envs.transforms import axis_angle_quat
 
-HIDDEN_XY = (-2.0, 0.0)  # unused props wait on the floor behind the robot, out of every camera's view
+HIDDEN_XY = (-2.0, -0.6)  # unused props wait on the floor behind the robot, out of every camera's view
 
 
 def set_free_pose(model: mujoco.MjModel, data: mujoco.MjData, body: str, pos, yaw_rad: float = 0.0) -> None:
@@ -31,9 +31,17 @@ def place_on_table(model, data, prop: str, x: float, y: float, yaw_rad: float) -
 
 
 def hide(model, data, props: list[str] | tuple[str, ...]) -> None:
-    """Park `props` in a row on the floor behind the robot."""
-    for i, prop in enumerate(props):
-        set_free_pose(model, data, prop, (HIDDEN_XY[0], HIDDEN_XY[1] + 0.2 * i, standing_z(prop, 0.0)))
+    """Park `props` on the floor behind the robot, each on its own spot."""
+    for prop in props:
+        slot = list(PROPS).index(prop)
+        set_free_pose(model, data, prop, (HIDDEN_XY[0], HIDDEN_XY[1] + 0.25 * slot, standing_z(prop, 0.0)))
+
+
+def set_mocap_pose(model: mujoco.MjModel, data: mujoco.MjData, body: str, pos, yaw_rad: float = 0.0) -> None:
+    """Move a kinematic (mocap) body to world position `pos`, rotated `yaw_rad` about z."""
+    mocap = model.body(body).mocapid[0]
+    data.mocap_pos[mocap] = pos
+    data.mocap_quat[mocap] = axis_angle_quat((0.0, 0.0, 1.0), yaw_rad)
 
 
 def body_speed(model: mujoco.MjModel, data: mujoco.MjData, body: str) -> float:

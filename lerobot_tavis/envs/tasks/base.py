@@ -1,31 +1,39 @@
-"""The task interface: scene geometry, episode sampling, prompt and success; no control code.
+"""The task interface: scene geometry, variants (splits), episode sampling, prompt and success; no control code.
 
 Life cycle: `build(spec)` adds the task's props and scenery to the world spec; after compilation `bind(model)`
-resolves ids; every episode `initialize_episode(model, data, rng)` places things (all randomness from `rng`);
-each policy step `after_step(data, step)` updates task state (a light, say) and `is_success(data)` is checked.
+resolves ids; every episode `initialize_episode(model, data, rng)` places things (all randomness from `rng`) and
+picks the prompt; after each policy step `after_step(model, data, step)` updates task state (a light, say) and
+`is_success(data)` is checked.
 """
 
 from __future__ import annotations
 
 import abc
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import mujoco
 import numpy as np
 
+from lerobot_tavis.envs.objects import OBJECT_NAMES, YCB_OBJECTS, add_prop
+from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.tasks.catalog import TaskInfo
+
+MAX_SUCCESS_SPEED_M_S = 1.0
 
 
 class Task(abc.ABC):
     info: ClassVar[TaskInfo]
+    VARIANTS: ClassVar[dict[str, Any]]  # "id" and "ood_spatial" presets (reference §2)
     has_table: ClassVar[bool] = True
     blacked_out_cameras: ClassVar[frozenset[str]] = frozenset()
 
-    def __init__(self, split: str = "id"):
-        if split not in self.info.splits:
-            raise ValueError(f"split of task {self.info.name!r} must be one of {self.info.splits}, got {split!r}")
-        self.split = split
-        self._prompt = self.info.prompts[0]
+    def __init__(self, variant: str = "id"):
+        if variant not in self.VARIANTS:
+            raise ValueError(f"variant of task {self.info.name!r} must be one of {sorted(self.VARIANTS)}, "
+                             f"got {variant!r}")
+        self.variant_name = variant
+        self.variant = self.VARIANTS[variant]
+        self.prompt = self.info.prompts[0]
 
     @abc.abstractmethod
     def build(self, spec: mujoco.MjSpec) -> None:
@@ -36,7 +44,7 @@ class Task(abc.ABC):
 
     @abc.abstractmethod
     def initialize_episode(self, model: mujoco.MjModel, data: mujoco.MjData, rng: np.random.Generator) -> None:
-        """Sample and apply this episode's layout and task state."""
+        """Sample and apply this episode's layout, task state and prompt."""
 
     def after_step(self, model: mujoco.MjModel, data: mujoco.MjData, step: int) -> None:
         """Update task state after policy step number `step` (1-based)."""
@@ -45,10 +53,35 @@ class Task(abc.ABC):
     def is_success(self, data: mujoco.MjData) -> bool:
         ...
 
-    @property
-    def prompt(self) -> str:
-        return self._prompt
-
     def props(self) -> tuple[str, ...]:
         """Names of the free bodies whose motion must die down before the first observation."""
         return ()
+
+
+class YcbTask(Task, abc.ABC):
+    """A task with the five YCB objects (those not used in an episode wait off-stage) and one target prop."""
+
+    success_height_m: ClassVar[float] = 1.2
+
+    def __init__(self, variant: str = "id"):
+        super().__init__(variant)
+        self.target = OBJECT_NAMES[0]
+
+    def build(self, spec: mujoco.MjSpec) -> None:
+        for name in OBJECT_NAMES:
+            add_prop(spec, YCB_OBJECTS[name])
+
+    def bind(self, model: mujoco.MjModel) -> None:
+        self._model = model
+
+    def props(self) -> tuple[str, ...]:
+        return OBJECT_NAMES
+
+    def is_success(self, data: mujoco.MjData) -> bool:
+        return lifted_above(self._model, data, self.target, self.success_height_m)
+
+
+def lifted_above(model: mujoco.MjModel, data: mujoco.MjData, body: str, height_m: float) -> bool:
+    """The reference's lift rule: the body's origin above `height_m` (world z) and slower than 1 m/s."""
+    return bool(data.xpos[model.body(body).id][2] > height_m
+                and body_speed(model, data, body) < MAX_SUCCESS_SPEED_M_S)

@@ -20,18 +20,66 @@ class TaskInfo:
     splits: tuple[str, ...] = SPLITS
 
 
+LIFT_PROMPTS = {
+    "soup_can": ("Pick up the tomato soup can and lift it.", "Grasp the soup can and hold it up.",
+                 "Lift the red soup can off the table."),
+    "meat_can": ("Pick up the potted meat can and lift it.", "Grasp the can of spam and hold it up.",
+                 "Lift the meat can off the table."),
+    "tuna_fish_can": ("Pick up the tuna fish can and lift it.", "Grasp the tuna can and hold it up.",
+                      "Lift the tuna fish can off the table."),
+    "gelatin_box": ("Pick up the gelatin box and lift it.", "Grasp the gelatin box and hold it up.",
+                    "Lift the gelatin box off the table."),
+    "pudding_box": ("Pick up the pudding box and lift it.", "Grasp the pudding box and hold it up.",
+                    "Lift the pudding box off the table."),
+}
+SHELF_PROMPTS = {
+    "soup_can": ("Find the tomato soup can on the shelf and bring it to me.",
+                 "Retrieve the soup can from the shelves.",
+                 "Look through the shelves, find the red soup can, and take it."),
+    "meat_can": ("Find the potted meat can on the shelf and bring it to me.",
+                 "Retrieve the spam can from the shelves.",
+                 "Look through the shelves, find the meat can, and take it."),
+    "tuna_fish_can": ("Find the tuna fish can on the shelf and bring it to me.",
+                      "Retrieve the tuna can from the shelves.",
+                      "Look through the shelves, find the tuna can, and take it."),
+    "gelatin_box": ("Find the gelatin box on the shelf and bring it to me.",
+                    "Retrieve the gelatin box from the shelves.",
+                    "Look through the shelves, find the gelatin box, and take it."),
+    "pudding_box": ("Find the pudding box on the shelf and bring it to me.",
+                    "Retrieve the pudding box from the shelves.",
+                    "Look through the shelves, find the pudding box, and take it."),
+}
+CUBE_PROMPT = "Find the red cube and pick it up."
+LIFT_RULE = "the {what}'s origin is above {z} m and moving slower than 1 m/s"
+
 TASKS: dict[str, TaskInfo] = {
     info.name: info
     for info in (
-        TaskInfo(
-            name="tabletop",
-            suite="sandbox",
-            prompts=("Look at the objects on the table.",),
-            success_rule="never succeeds: a free scene (the five YCB objects on the table) for trying the robots",
-            splits=("id",),
-        ),
+        TaskInfo("conditional_pick", "tavis_head",
+                 ("Look at the card. If it is red, pick the object on the left. If it is green, pick the object on "
+                  "the right.",),
+                 LIFT_RULE.format(what="target (left object if the card is red, right if green)", z=1.2)),
+        TaskInfo("wait_then_act", "tavis_head",
+                 ("Watch the red light. When it turns green, pick up the object.",),
+                 "once the light is green: " + LIFT_RULE.format(what="object", z=1.2)),
+        TaskInfo("clutter_pick_cube", "tavis_head", (CUBE_PROMPT,), LIFT_RULE.format(what="red cube", z=1.2)),
+        TaskInfo("clutter_pick_lift", "tavis_head", tuple(p for ps in LIFT_PROMPTS.values() for p in ps),
+                 LIFT_RULE.format(what="named object", z=1.2)),
+        TaskInfo("multi_shelf_scan", "tavis_head", tuple(p for ps in SHELF_PROMPTS.values() for p in ps),
+                 "the named object's origin is closer than x = 0.435 m (out of the shelf) and moving slower than "
+                 "1 m/s"),
+        TaskInfo("peeking_box", "tavis_hands", ("Retrieve the object from inside the box.",),
+                 LIFT_RULE.format(what="object", z=1.25)),
+        TaskInfo("occluded_reach", "tavis_hands", ("Reach around the screen and pick up the object behind it.",),
+                 LIFT_RULE.format(what="object", z=1.25)),
+        TaskInfo("blocked_clutter_pick_cube", "tavis_hands", (CUBE_PROMPT,),
+                 LIFT_RULE.format(what="red cube", z=1.2) + "; the head camera image is black"),
+        TaskInfo("tabletop", "sandbox", ("Look at the objects on the table.",),
+                 "never succeeds: a free scene (the five YCB objects on the table) for trying the robots",
+                 splits=("id",)),
     )
 }
+SUITES = ("tavis_head", "tavis_hands")
 
 
 def suite_tasks(suite: str) -> tuple[str, ...]:

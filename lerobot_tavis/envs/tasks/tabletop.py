@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from lerobot_tavis.envs import placement
-from lerobot_tavis.envs.objects import OBJECT_NAMES, YCB_OBJECTS, add_prop
-from lerobot_tavis.envs.tasks.base import Task
+from lerobot_tavis.envs.objects import OBJECT_NAMES
+from lerobot_tavis.envs.tasks.base import YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 
 ROW_X = 0.42
@@ -15,12 +14,9 @@ ROW_Y = np.linspace(0.24, -0.24, len(OBJECT_NAMES))
 JITTER_M = 0.02
 
 
-class Tabletop(Task):
+class Tabletop(YcbTask):
     info = TASKS["tabletop"]
-
-    def build(self, spec: mujoco.MjSpec) -> None:
-        for name in OBJECT_NAMES:
-            add_prop(spec, YCB_OBJECTS[name])
+    VARIANTS = {"id": None}
 
     def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
         for name, y in zip(OBJECT_NAMES, ROW_Y):
@@ -29,6 +25,3 @@ class Tabletop(Task):
 
     def is_success(self, data) -> bool:
         return False
-
-    def props(self) -> tuple[str, ...]:
-        return OBJECT_NAMES

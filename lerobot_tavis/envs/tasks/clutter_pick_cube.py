@@ -1,0 +1,35 @@
+"""TAVIS-Head clutter_pick_cube: the red cube among four of the five YCB objects; pick up the cube."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lerobot_tavis.envs import placement
+from lerobot_tavis.envs.objects import OBJECT_NAMES, RED_CUBE, add_prop
+from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.catalog import TASKS
+from lerobot_tavis.envs.tasks.clutter_pick_lift import CLUTTER_VARIANTS, scatter
+
+
+class ClutterPickCube(YcbTask):
+    info = TASKS["clutter_pick_cube"]
+    VARIANTS = CLUTTER_VARIANTS
+
+    def __init__(self, variant: str = "id"):
+        super().__init__(variant)
+        self.target = RED_CUBE.name
+        self.absent = OBJECT_NAMES[0]
+
+    def build(self, spec) -> None:
+        super().build(spec)
+        add_prop(spec, RED_CUBE)
+
+    def props(self) -> tuple[str, ...]:
+        return (*OBJECT_NAMES, RED_CUBE.name)
+
+    def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
+        # As in the reference, all six are laid out (cube last) and then one YCB object is taken away, so its
+        # slot stays empty.
+        scatter(model, data, rng, self.variant, (*OBJECT_NAMES, RED_CUBE.name))
+        self.absent = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
+        placement.hide(model, data, [self.absent])

@@ -1,0 +1,43 @@
+"""TAVIS-Head clutter_pick_lift: five YCB objects scattered on the table; lift the one the prompt names."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lerobot_tavis.envs import placement
+from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
+from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.catalog import LIFT_PROMPTS, TASKS
+from lerobot_tavis.envs.tasks.layout import Box2D, sample_separated
+
+
+@dataclass(frozen=True)
+class ClutterVariant:
+    region: Box2D
+    min_separation_m: float
+
+
+CLUTTER_VARIANTS = {
+    "id": ClutterVariant(Box2D(x=(0.35, 0.45), y=(-0.25, 0.25)), 0.10),
+    "ood_spatial": ClutterVariant(Box2D(x=(0.30, 0.50), y=(-0.35, 0.35)), 0.05),
+}
+
+
+def scatter(model, data, rng: np.random.Generator, variant: ClutterVariant, names: tuple[str, ...]) -> None:
+    """Place `names` upright at separated positions with random yaw, in the given order."""
+    positions = sample_separated(rng, variant.region, [PROPS[n].footprint_radius_m for n in names],
+                                 variant.min_separation_m)
+    for name, (x, y) in zip(names, positions):
+        placement.place_on_table(model, data, name, x, y, rng.uniform(-np.pi, np.pi))
+
+
+class ClutterPickLift(YcbTask):
+    info = TASKS["clutter_pick_lift"]
+    VARIANTS = CLUTTER_VARIANTS
+
+    def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
+        self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
+        self.prompt = LIFT_PROMPTS[self.target][rng.integers(3)]
+        scatter(model, data, rng, self.variant, OBJECT_NAMES)

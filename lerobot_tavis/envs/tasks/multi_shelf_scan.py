@@ -1,0 +1,81 @@
+"""TAVIS-Head multi_shelf_scan: five objects in six slots of a three-shelf unit; take the named one out.
+
+No table. Success: the target's origin is nearer than x = 0.435 m (out of the shelf) and slower than 1 m/s; no
+height condition (reference §2.5).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from lerobot_tavis.envs import physics, placement
+from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
+from lerobot_tavis.envs.placement import body_speed
+from lerobot_tavis.envs.tasks.base import MAX_SUCCESS_SPEED_M_S, YcbTask
+from lerobot_tavis.envs.tasks.catalog import SHELF_PROMPTS, TASKS
+
+WOOD = (0.55, 0.35, 0.20, 1.0)
+SHELF_X, SHELF_DEPTH, SHELF_WIDTH = 0.52, 0.11, 0.70
+BOARD_THICKNESS = 0.02
+BOARD_Z = (0.97, 1.10, 1.27)  # centres of the three shelf boards; the top board is at 1.52
+TOP_BOARD_Z = 1.52
+SLOT_Y = (0.15, -0.15)
+SLOTS = tuple((shelf, y) for shelf in range(3) for y in SLOT_Y)  # 6 slots: the reference removed the middle ones
+SLOT_X_CLAMP = (0.485, 0.555)
+SLOT_Y_CLAMP = (-0.32, 0.32)
+INNER_X = (SHELF_X - SHELF_DEPTH / 2, SHELF_X + SHELF_DEPTH / 2 - 0.005)  # open front .. back panel
+INNER_Y = (-SHELF_WIDTH / 2, SHELF_WIDTH / 2)
+SUCCESS_X = SHELF_X - SHELF_DEPTH / 2 - 0.03  # 0.435 m
+
+
+@dataclass(frozen=True)
+class ShelfVariant:
+    jitter_x_m: float
+    jitter_y_m: float
+
+
+class MultiShelfScan(YcbTask):
+    info = TASKS["multi_shelf_scan"]
+    VARIANTS = {"id": ShelfVariant(0.03, 0.03), "ood_spatial": ShelfVariant(0.03, 0.10)}
+    has_table = False
+
+    def __init__(self, variant: str = "id"):
+        super().__init__(variant)
+        self.slots: dict[str, tuple[int, float]] = {}
+
+    def build(self, spec) -> None:
+        super().build(spec)
+        shelf = spec.worldbody.add_body(name="shelf")
+        height = TOP_BOARD_Z - BOARD_Z[0] + BOARD_THICKNESS
+        mid_z = (BOARD_Z[0] + TOP_BOARD_Z) / 2
+        boxes = [(f"shelf/board{i}", (SHELF_X, 0.0, z), (SHELF_DEPTH, SHELF_WIDTH, BOARD_THICKNESS))
+                 for i, z in enumerate((*BOARD_Z, TOP_BOARD_Z))]
+        boxes += [(f"shelf/side{i}", (SHELF_X, s * (SHELF_WIDTH / 2 + 0.01), mid_z), (SHELF_DEPTH, 0.02, height))
+                  for i, s in enumerate((1, -1))]
+        boxes.append(("shelf/back", (SHELF_X + SHELF_DEPTH / 2 + 0.005, 0.0, mid_z), (0.01, SHELF_WIDTH, height)))
+        for name, pos, size in boxes:
+            geom = shelf.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX, pos=pos, size=[s / 2 for s in size])
+            physics.style_geom(geom, physics.STATIC, WOOD)
+
+    def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
+        chosen = rng.choice(len(SLOTS), size=len(OBJECT_NAMES), replace=False)
+        self.slots = {name: SLOTS[i] for name, i in zip(OBJECT_NAMES, chosen)}
+        self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
+        self.prompt = SHELF_PROMPTS[self.target][rng.integers(3)]
+        for name, (shelf, slot_y) in self.slots.items():
+            jitter = rng.uniform(-1.0, 1.0, size=2) * (self.variant.jitter_x_m, self.variant.jitter_y_m)
+            yaw = rng.uniform(-np.pi, np.pi)
+            hx, hy = PROPS[name].half_extent_xy(yaw)
+            # the reference's clamps, tightened so an object never sticks into the back panel or a side wall
+            x = np.clip(SHELF_X + jitter[0], max(SLOT_X_CLAMP[0], INNER_X[0] + hx), min(SLOT_X_CLAMP[1], INNER_X[1] - hx))
+            y = np.clip(slot_y + jitter[1], max(SLOT_Y_CLAMP[0], INNER_Y[0] + hy), min(SLOT_Y_CLAMP[1], INNER_Y[1] - hy))
+            surface = BOARD_Z[shelf] + BOARD_THICKNESS / 2
+            placement.set_free_pose(model, data, name, (x, y, placement.standing_z(name, surface)), yaw)
+
+    def is_success(self, data) -> bool:
+        body = self._model.body(self.target).id
+        return bool(data.xpos[body][0] < SUCCESS_X
+                    and body_speed(self._model, data, self.target) < MAX_SUCCESS_SPEED_M_S)

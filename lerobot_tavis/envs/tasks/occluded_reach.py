@@ -1,0 +1,55 @@
+"""TAVIS-Hands occluded_reach: an object behind a portrait monitor; reach around the screen and lift it.
+
+The screen (fixed) hides the object from the head camera; success: the object's origin above 1.25 m and slower
+than 1 m/s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from lerobot_tavis.envs import physics, placement
+from lerobot_tavis.envs.objects import OBJECT_NAMES
+from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.catalog import TASKS
+from lerobot_tavis.envs.tasks.layout import Box2D
+
+FRAME_RGBA = (0.18, 0.18, 0.18, 1.0)
+PANEL_RGBA = (0.05, 0.05, 0.05, 1.0)
+SCREEN_X = 0.27
+# name -> (full size, centre, colour)
+SCREEN_PARTS = {
+    "screen/base": ((0.15, 0.10, 0.02), (SCREEN_X, 0.0, 1.01), FRAME_RGBA),
+    "screen/post": ((0.03, 0.03, 0.10), (SCREEN_X, 0.0, 1.07), FRAME_RGBA),
+    "screen/panel": ((0.015, 0.16, 0.40), (SCREEN_X, 0.0, 1.32), PANEL_RGBA),  # spans z 1.12-1.52
+}
+
+
+@dataclass(frozen=True)
+class OccludedVariant:
+    object_zone: Box2D
+
+
+class OccludedReach(YcbTask):
+    info = TASKS["occluded_reach"]
+    success_height_m = 1.25
+    VARIANTS = {
+        "id": OccludedVariant(Box2D((0.40, 0.50), (-0.20, 0.20))),
+        "ood_spatial": OccludedVariant(Box2D((0.36, 0.53), (-0.30, 0.30))),
+    }
+
+    def build(self, spec) -> None:
+        super().build(spec)
+        screen = spec.worldbody.add_body(name="screen")
+        for name, (size, centre, rgba) in SCREEN_PARTS.items():
+            geom = screen.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX, pos=centre, size=[s / 2 for s in size])
+            physics.style_geom(geom, physics.STATIC, rgba)
+
+    def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
+        self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
+        x, y = self.variant.object_zone.sample(rng)
+        placement.place_on_table(model, data, self.target, x, y, rng.uniform(-np.pi, np.pi))
+        placement.hide(model, data, [n for n in OBJECT_NAMES if n != self.target])

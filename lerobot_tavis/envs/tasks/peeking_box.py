@@ -1,0 +1,92 @@
+"""TAVIS-Hands peeking_box: an object inside a closed box with one open side (+y or -y); retrieve and lift it.
+
+The front and back walls span the full width, so the opening is not visible head-on: a wrist camera has to look.
+Success: the object's origin above 1.25 m and slower than 1 m/s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from lerobot_tavis.envs import physics, placement
+from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
+from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.catalog import TASKS
+from lerobot_tavis.envs.transforms import axis_angle_quat, matrix_from_quat
+
+BOX = "box"
+WOOD = (0.55, 0.35, 0.20, 1.0)
+HALF_DEPTH, HALF_WIDTH, HEIGHT, WALL = 0.20, 0.07, 0.20, 0.008
+BOTTOM_Z = 0.995  # sunk 5 mm into the table
+WALL_Z = BOTTOM_Z + HEIGHT / 2
+# name -> (full size x, y, z; centre in the box frame)
+WALLS = {
+    "back": ((WALL, 2 * (HALF_WIDTH + WALL), HEIGHT), (HALF_DEPTH + WALL / 2, 0.0, WALL_Z)),
+    "front": ((WALL, 2 * (HALF_WIDTH + WALL), HEIGHT), (-HALF_DEPTH - WALL / 2, 0.0, WALL_Z)),
+    "top": ((2 * (HALF_DEPTH + WALL), 2 * (HALF_WIDTH + WALL), WALL), (0.0, 0.0, BOTTOM_Z + HEIGHT + WALL / 2)),
+    "+y": ((2 * HALF_DEPTH, WALL, HEIGHT), (0.0, HALF_WIDTH + WALL / 2, WALL_Z)),
+    "-y": ((2 * HALF_DEPTH, WALL, HEIGHT), (0.0, -HALF_WIDTH - WALL / 2, WALL_Z)),
+}
+
+
+@dataclass(frozen=True)
+class BoxVariant:
+    box_x: tuple[float, float]
+    box_y: tuple[float, float]
+    box_yaw_rad: tuple[float, float]
+    object_dx: tuple[float, float]
+    object_dy: tuple[float, float]
+
+
+class PeekingBox(YcbTask):
+    info = TASKS["peeking_box"]
+    success_height_m = 1.25
+    VARIANTS = {
+        "id": BoxVariant((0.41, 0.45), (-0.04, 0.04), tuple(np.radians((-5.0, 5.0))), (-0.04, 0.04), (-0.02, 0.02)),
+        "ood_spatial": BoxVariant((0.39, 0.47), (-0.04, 0.04), tuple(np.radians((-10.0, 10.0))), (-0.04, 0.04),
+                                  (-0.04, 0.04)),
+    }
+
+    def __init__(self, variant: str = "id"):
+        super().__init__(variant)
+        self.open_side = "+y"
+        self.box_center = np.array([0.43, 0.0])
+        self.box_yaw = 0.0
+
+    def build(self, spec) -> None:
+        super().build(spec)
+        box = spec.worldbody.add_body(name=BOX, mocap=True)
+        for wall, (size, centre) in WALLS.items():
+            geom = box.add_geom(name=f"box/{wall}", type=mujoco.mjtGeom.mjGEOM_BOX, pos=centre,
+                                size=[s / 2 for s in size])
+            physics.style_geom(geom, physics.STATIC, WOOD)
+
+    def bind(self, model) -> None:
+        super().bind(model)
+        self._side_geoms = {side: model.geom(f"box/{side}").id for side in ("+y", "-y")}
+        self._wall_style = {side: (model.geom_contype[g], model.geom_conaffinity[g], model.geom_group[g])
+                            for side, g in self._side_geoms.items()}
+
+    def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
+        v = self.variant
+        self.box_center = np.array([rng.uniform(*v.box_x), rng.uniform(*v.box_y)])
+        self.box_yaw = float(rng.uniform(*v.box_yaw_rad))
+        self.open_side = ("+y", "-y")[rng.integers(2)]
+        self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
+        placement.set_mocap_pose(model, data, BOX, (*self.box_center, 0.0), self.box_yaw)
+        for side, geom in self._side_geoms.items():
+            contype, conaffinity, group = self._wall_style[side] if side != self.open_side else (0, 0, 3)
+            model.geom_contype[geom], model.geom_conaffinity[geom], model.geom_group[geom] = contype, conaffinity, group
+        yaw = rng.uniform(-np.pi, np.pi)
+        # keep the object inside the walls whatever its yaw (the reference's offsets can push a long box into one)
+        hx, hy = PROPS[self.target].half_extent_xy(yaw)
+        dx = np.clip(rng.uniform(*v.object_dx), -HALF_DEPTH + hx, HALF_DEPTH - hx)
+        dy = np.clip(rng.uniform(*v.object_dy), -HALF_WIDTH + hy + 0.003, HALF_WIDTH - hy - 0.003)
+        rotation = matrix_from_quat(axis_angle_quat((0, 0, 1), self.box_yaw))[:2, :2]
+        x, y = self.box_center + rotation @ (dx, dy)
+        placement.place_on_table(model, data, self.target, x, y, self.box_yaw + yaw)
+        placement.hide(model, data, [n for n in OBJECT_NAMES if n != self.target])
+

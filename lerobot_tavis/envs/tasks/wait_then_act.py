@@ -1,0 +1,77 @@
+"""TAVIS-Head wait_then_act: watch a red light; once it turns green (after a seeded delay), lift the object.
+
+Lifting before the light is green does not end the episode (as in the reference); success counts only once the
+light is green, and fires at once if the object is already held up when it turns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from lerobot_tavis.envs import placement
+from lerobot_tavis.envs.objects import OBJECT_NAMES, add_marker
+from lerobot_tavis.envs.physics import POLICY_HZ
+from lerobot_tavis.envs.scene import TABLE_TOP_Z
+from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.catalog import TASKS
+from lerobot_tavis.envs.tasks.layout import Box2D
+
+LIGHT = "signal_light"
+LIGHT_RADIUS_M = 0.03
+RED = (1.0, 0.0, 0.0, 1.0)
+GREEN = (0.0, 1.0, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class WaitVariant:
+    object_zone: Box2D
+    light_zone: Box2D
+    delay_range_s: tuple[float, float]
+
+
+class WaitThenAct(YcbTask):
+    info = TASKS["wait_then_act"]
+    VARIANTS = {
+        "id": WaitVariant(Box2D((0.35, 0.45), (-0.12, 0.12)), Box2D((0.60, 0.70), (-0.10, 0.10)), (2.0, 5.0)),
+        "ood_spatial": WaitVariant(Box2D((0.30, 0.50), (-0.20, 0.20)), Box2D((0.55, 0.75), (-0.15, 0.15)),
+                                   (2.0, 8.0)),
+    }
+
+    def __init__(self, variant: str = "id"):
+        super().__init__(variant)
+        self.delay_s = 0.0
+        self.green_step = 0
+        self.is_green = False
+
+    def build(self, spec) -> None:
+        super().build(spec)
+        add_marker(spec, LIGHT, mujoco.mjtGeom.mjGEOM_SPHERE, (LIGHT_RADIUS_M, 0.0, 0.0), RED)
+
+    def bind(self, model) -> None:
+        super().bind(model)
+        self._light_geom = model.geom(LIGHT).id
+
+    def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
+        self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
+        self.delay_s = float(rng.uniform(*self.variant.delay_range_s))
+        self.green_step = int(self.delay_s * POLICY_HZ)  # truncation, as the reference
+        x, y = self.variant.object_zone.sample(rng)
+        placement.place_on_table(model, data, self.target, x, y, rng.uniform(-np.pi, np.pi))
+        placement.hide(model, data, [n for n in OBJECT_NAMES if n != self.target])
+        x, y = self.variant.light_zone.sample(rng)
+        placement.set_mocap_pose(model, data, LIGHT, (x, y, TABLE_TOP_Z + LIGHT_RADIUS_M))
+        self._set_green(model, False)
+
+    def after_step(self, model, data, step: int) -> None:
+        if not self.is_green and step >= self.green_step:
+            self._set_green(model, True)
+
+    def is_success(self, data) -> bool:
+        return self.is_green and super().is_success(data)
+
+    def _set_green(self, model, green: bool) -> None:
+        self.is_green = green
+        model.geom_rgba[self._light_geom] = GREEN if green else RED
