@@ -19,6 +19,7 @@ class EmptyRoom(Task):
     """No table, no props: reach targets at table height must not collide with anything."""
 
     info = TaskInfo("empty_room", "test", ("",), "never")
+    VARIANTS = {"id": None}
     has_table = False
 
     def build(self, spec):
