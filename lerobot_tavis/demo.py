@@ -44,9 +44,9 @@ def look_and_reach_script(env: TavisEnv, target: str) -> tuple[ActionScript, flo
         Keyframe(hover, 1.5),
         Keyframe(pre, 0.8),
         Keyframe(grasp.action(ik, look), 0.8),
-        Keyframe(grasp.action(ik, look, gripper=canonical.GRIPPER_CLOSED), 0.8),
-        Keyframe(grasp.lifted(0.2).action(ik, look, gripper=canonical.GRIPPER_CLOSED), 1.5),
-        Keyframe(grasp.lifted(0.2).action(ik, look, gripper=canonical.GRIPPER_CLOSED), 0.7),
+        Keyframe(grasp.action(ik, look, closed=True), 0.8),
+        Keyframe(grasp.lifted(0.2).action(ik, look, closed=True), 1.5),
+        Keyframe(grasp.lifted(0.2).action(ik, look, closed=True), 0.7),
     ]
     closed_at = sum(k.duration_s for k in keyframes[:7])
     return ActionScript(canonical.rest_action(), keyframes), closed_at

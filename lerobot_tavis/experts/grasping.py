@@ -15,13 +15,16 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.control import ArmIK
 from lerobot_tavis.envs.objects import PropSpec
-from lerobot_tavis.envs.scene import TABLE_TOP_Z
 from lerobot_tavis.envs.transforms import axis_angle_quat, quat_multiply
 
-PITCHES_RAD = np.radians((30.0, 45.0, 15.0, 60.0))
-MAX_AZIMUTH_RAD = 1.1
+PITCHES_RAD = np.radians((45.0, 60.0, 30.0, 75.0, 15.0))
+MAX_AZIMUTH_RAD = np.pi / 2
 WIDTH_MARGIN_M = 0.012
 FLOOR_CLEARANCE_M = 0.006
+CORRIDOR_MARGIN_M = 0.005
+PRESHAPE_MARGIN_M = 0.03  # open this much wider than the object
+FOREARM_CLEARANCE_M = 0.08
+CYLINDER_AZIMUTH_OFFSETS_RAD = (0.0, -0.35, 0.35, -0.7, 0.7)
 
 
 @dataclass(frozen=True)
@@ -31,11 +34,17 @@ class Grasp:
     pitch_rad: float  # approach angle below horizontal
     azimuth_rad: float  # approach direction about world z (0 = forward)
     flipped: bool
+    opening_m: float = 1.0  # pre-grasp opening (pre-shaped to the object; clipped to the stroke)
 
     @property
     def approach(self) -> np.ndarray:
         c = np.cos(self.pitch_rad)
         return np.array([c * np.cos(self.azimuth_rad), c * np.sin(self.azimuth_rad), -np.sin(self.pitch_rad)])
+
+    @property
+    def closing_direction(self) -> np.ndarray:
+        """Horizontal unit vector along which the fingers close."""
+        return np.array([-np.sin(self.azimuth_rad), np.cos(self.azimuth_rad), 0.0])
 
     @property
     def hand_quat(self) -> np.ndarray:
@@ -44,8 +53,12 @@ class Grasp:
                              axis_angle_quat((0, 1, 0), self.pitch_rad - np.pi / 2))
         return quat_multiply(quat, axis_angle_quat((0, 0, 1), np.pi)) if self.flipped else quat
 
+    def moved(self, offset_m) -> Grasp:
+        """The same hand orientation with the grasp point shifted by `offset_m` (world, m): carrying."""
+        return replace(self, point=self.point + np.asarray(offset_m, dtype=float))
+
     def lifted(self, height_m: float) -> Grasp:
-        return replace(self, point=self.point + np.array([0.0, 0.0, height_m]))
+        return self.moved((0.0, 0.0, height_m))
 
     def ee_pose(self, ik: ArmIK, offset_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Canonical end-effector position and quaternion that put the pads on the grasp point, backed off
@@ -54,60 +67,95 @@ class Grasp:
         wrist = self.point - (robot.gripper.grasp_depth_m + offset_m) * self.approach
         return wrist - np.asarray(robot.canonical_origin), robot.ee_quat_for_hand(self.side, self.hand_quat)
 
-    def action(self, ik: ArmIK, base: np.ndarray, offset_m: float = 0.0, gripper: float | None = None) -> np.ndarray:
-        """`base` with this arm's pose (and optionally gripper) replaced."""
+    def action(self, ik: ArmIK, base: np.ndarray, offset_m: float = 0.0, closed: bool = False) -> np.ndarray:
+        """`base` with this arm's pose replaced and its gripper pre-shaped open, or closed."""
         slots = canonical.LEFT if self.side == "left" else canonical.RIGHT
         action = base.copy()
         action[slots.position], action[slots.quaternion] = self.ee_pose(ik, offset_m)
-        if gripper is not None:
-            action[slots.gripper] = gripper
+        stroke = ik.robot.gripper.stroke_m
+        action[slots.gripper] = canonical.GRIPPER_CLOSED if closed else 1.0 - 2.0 * min(self.opening_m, stroke) / stroke
         return action
 
 
 def _reach_score(ik: ArmIK, grasp: Grasp) -> float:
+    """How far (m) the pads would end from the grasp point: wrist error plus the tilt error's lever arm."""
     position_error, angle_error = ik.reach_error(grasp.action(ik, canonical.rest_action()), grasp.side)
-    return position_error + 0.02 * angle_error
+    return position_error + ik.robot.gripper.grasp_depth_m * angle_error
 
 
 def closing_azimuths(prop: PropSpec, yaw_rad: float, stroke_m: float, toward_rad: float) -> list[float]:
     """Approach azimuths (rad) whose closing direction spans a prop side that fits in the gripper.
 
-    Cylinders can be approached from `toward_rad` (the arm's natural direction); a box from across either of its
-    horizontal axes (closing along the other). Azimuths are wrapped to [-pi, pi] and sorted by closeness to
-    `toward_rad`.
+    Cylinders are approached from around `toward_rad` (the arm's natural direction); a box from across either of its
+    horizontal axes (closing along the other), from whichever side faces `toward_rad`. Sorted by closeness to
+    `toward_rad`, wrapped to [-pi, pi].
     """
     if prop.shape == "cylinder":
-        return [toward_rad]
+        return [toward_rad + offset for offset in CYLINDER_AZIMUTH_OFFSETS_RAD]
     options = []
     for closing_axis, width in ((0, prop.size_m[0]), (1, prop.size_m[1])):
         if width > stroke_m - WIDTH_MARGIN_M:
             continue
-        closing_dir = yaw_rad + closing_axis * np.pi / 2
-        for k in range(4):  # the approach is perpendicular to the closing direction, from either side
-            azimuth = np.angle(np.exp(1j * (closing_dir + np.pi / 2 + k * np.pi)))
-            if k < 2:
-                options.append(float(azimuth))
-    return sorted(set(options), key=lambda a: abs(np.angle(np.exp(1j * (a - toward_rad)))))
+        approach = yaw_rad + closing_axis * np.pi / 2 + np.pi / 2  # perpendicular to the closing direction
+        if np.cos(approach - toward_rad) < 0:
+            approach += np.pi  # the side facing the hand
+        options.append(float(np.angle(np.exp(1j * approach))))
+    return sorted(options, key=lambda a: abs(np.angle(np.exp(1j * (a - toward_rad)))))
 
 
-def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad: float, lift_m: float = 0.2,
-               tolerance_m: float = 0.008) -> Grasp:
-    """The first grasp whose grasp pose and lifted pose (`lift_m` higher) are both kinematically reachable, in
-    order of preference (upright hand, natural azimuth, moderate pitch), else the best-scoring one."""
-    shoulder_y = 0.2 if side == "left" else -0.2
-    toward = float(np.arctan2(center[1] - shoulder_y, max(center[0], 0.05)))
+def width_across(prop: PropSpec, yaw_rad: float, direction: np.ndarray) -> float:
+    """Extent (m) of an upright prop along a horizontal direction."""
+    if prop.shape == "cylinder":
+        return prop.size_m[0]
+    axes = np.array([[np.cos(yaw_rad), np.sin(yaw_rad)], [-np.sin(yaw_rad), np.cos(yaw_rad)]])
+    return float(np.abs(axes @ direction[:2]) @ prop.size_m[:2])
+
+
+def hand_clearance(grasp: Grasp, obstacles, reach_m: float, finger_thickness_m: float) -> tuple[float, float]:
+    """Gaps (m) between obstacles ((xy centre, footprint radius) pairs) and, seen from above, (1) the hand's
+    path: the segment from the grasp point back along the approach, `reach_m` long; (2) the open fingers."""
+    start = grasp.point[:2]
+    back = -grasp.approach[:2] * reach_m
+    fingers = [start + sign * (grasp.opening_m / 2 + finger_thickness_m) * grasp.closing_direction[:2]
+               for sign in (1.0, -1.0)]
+    path_gap = finger_gap = np.inf
+    for centre, radius in obstacles:
+        centre = np.asarray(centre)
+        t = np.clip(np.dot(centre - start, back) / max(np.dot(back, back), 1e-12), 0.0, 1.0)
+        path_gap = min(path_gap, float(np.linalg.norm(centre - (start + t * back))) - radius)
+        finger_gap = min(finger_gap, *(float(np.linalg.norm(centre - f)) - radius for f in fingers))
+    return path_gap, finger_gap
+
+
+def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad: float,
+               carry_m=(0.0, 0.0, 0.2), pitches_rad=PITCHES_RAD, max_azimuth_rad: float = MAX_AZIMUTH_RAD,
+               toward_rad: float | None = None, obstacles=(), tolerance_m: float = 0.008) -> Grasp:
+    """The first grasp that (1) keeps the hand's path clear of `obstacles` ((xy, radius) of the other props) and
+    (2) whose grasp pose and carried pose (grasp point + `carry_m`) are both kinematically reachable, in order
+    of preference: upright hand, azimuth nearest `toward_rad` (default: from the shoulder to the object), the
+    given pitch order. Without such a grasp, the best-scoring one. Azimuths farther than `max_azimuth_rad` from
+    `toward_rad` are not considered."""
+    if toward_rad is None:
+        shoulder_y = 0.2 if side == "left" else -0.2
+        toward_rad = float(np.arctan2(center[1] - shoulder_y, max(center[0], 0.05)))
     bottom = center[2] - prop.height_m / 2
     point = center.copy()
-    point[2] = max(center[2], bottom + ik.robot.gripper.pad_length_m / 2 + FLOOR_CLEARANCE_M,
-                   TABLE_TOP_Z + ik.robot.gripper.pad_length_m / 2 + FLOOR_CLEARANCE_M)
+    point[2] = max(center[2], bottom + ik.robot.gripper.pad_length_m / 2 + FLOOR_CLEARANCE_M)
+    azimuths = [a for a in closing_azimuths(prop, yaw_rad, ik.robot.gripper.stroke_m, toward_rad)
+                if abs(np.angle(np.exp(1j * (a - toward_rad)))) <= max_azimuth_rad]
+    gripper = ik.robot.gripper
+    reach = gripper.grasp_depth_m + FOREARM_CLEARANCE_M
     best, best_score = None, np.inf
-    azimuths = [a for a in closing_azimuths(prop, yaw_rad, ik.robot.gripper.stroke_m, toward)
-                if abs(a) <= MAX_AZIMUTH_RAD]
     for flipped in (False, True):
         for azimuth in azimuths:
-            for pitch in PITCHES_RAD:
-                grasp = Grasp(side, point, float(pitch), azimuth, flipped)
-                score = max(_reach_score(ik, grasp), _reach_score(ik, grasp.lifted(lift_m)))
+            closing = Grasp(side, point, 0.0, azimuth, flipped).closing_direction
+            opening = min(gripper.stroke_m, width_across(prop, yaw_rad, closing) + PRESHAPE_MARGIN_M)
+            for pitch in pitches_rad:
+                grasp = Grasp(side, point, float(pitch), azimuth, flipped, opening)
+                path_gap, finger_gap = hand_clearance(grasp, obstacles, reach * np.cos(pitch),
+                                                      gripper.finger_thickness_m + gripper.pad_thickness_m)
+                blocked = path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M or finger_gap < CORRIDOR_MARGIN_M
+                score = max(_reach_score(ik, grasp), _reach_score(ik, grasp.moved(carry_m))) + 0.05 * blocked
                 if score < tolerance_m:
                     return grasp
                 if score < best_score:

@@ -1,0 +1,110 @@
+"""Reusable human-like behaviours for the demonstrators: saccades and fixations, scans, peeks, reach-grasp-lift.
+
+Timing follows people: saccades of 0.15-0.25 s then still fixations; the hand starts toward the target while or
+just after the eyes land on it, so the gaze leads the grasp by roughly 0.5-1.2 s; minimum-jerk arm motion; the
+gripper closes with a ramp at the end of the approach; lifts at a human pace. Every duration is drawn from the
+expert's generator, so a dataset is not one trajectory repeated.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs.control import ArmIK
+from lerobot_tavis.envs.objects import PROPS
+from lerobot_tavis.experts.base import Expert, Hold, Move, Segment
+from lerobot_tavis.experts.gaze import GazeSolver
+from lerobot_tavis.experts.grasping import Grasp, plan_grasp
+
+SLOTS = {"left": canonical.LEFT, "right": canonical.RIGHT}
+
+
+class SkilledExpert(Expert):
+    """An expert with the shared skills; subclasses write `behaviour()` with them."""
+
+    def reset(self) -> None:
+        if not hasattr(self, "ik"):
+            self.ik = ArmIK(self.env.world.robot)
+            self.gaze = GazeSolver(self.env.world)
+        super().reset()
+
+    # -- state --------------------------------------------------------------------------------------------
+    def body_pose(self, name: str) -> tuple[np.ndarray, float]:
+        """World position of a body's origin and its yaw (rad)."""
+        model, data = self.env.model, self.env.data
+        body = model.body(name).id
+        rotation = data.xmat[body].reshape(3, 3)
+        return data.xpos[body].copy(), float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+
+    def side_for(self, point) -> str:
+        """The arm on the point's side of the body (y >= 0: left)."""
+        return "left" if point[1] >= 0 else "right"
+
+    # -- gaze -------------------------------------------------------------------------------------------------
+    def looking_at(self, point, base: np.ndarray | None = None) -> np.ndarray:
+        action = (self.command if base is None else base).copy()
+        action[canonical.HEAD_PITCH], action[canonical.HEAD_YAW] = self.gaze.angles_to(point)
+        action[canonical.HEAD_ROLL] = 0.0
+        return action
+
+    def saccade_s(self) -> float:
+        return self.uniform(0.15, 0.25)
+
+    def fixate(self, point, fixation_s: tuple[float, float] = (0.3, 0.6)) -> Iterator[Segment]:
+        """A saccade to `point` (world) followed by a still fixation."""
+        head_s = self.saccade_s()
+        yield Move(self.looking_at(point), head_s, head_s=head_s)
+        yield Hold(self.uniform(*fixation_s))
+
+    def scan(self, points, fixation_s=(0.3, 0.6)) -> Iterator[Segment]:
+        for point in points:
+            yield from self.fixate(point, fixation_s)
+
+    # -- hands ------------------------------------------------------------------------------------------------
+    def at_rest(self, base: np.ndarray | None = None, side: str | None = None) -> np.ndarray:
+        """`base` with one arm (or both) back at the rest pose."""
+        rest = canonical.rest_action()
+        action = (self.command if base is None else base).copy()
+        for s, slots in SLOTS.items():
+            if side in (None, s):
+                action[slots.position], action[slots.quaternion] = rest[slots.position], rest[slots.quaternion]
+        return action
+
+    def plan(self, name: str, side: str, carry_m, **kwargs) -> Grasp:
+        """A grasp of prop `name` whose approach avoids the other props near it."""
+        center, yaw = self.body_pose(name)
+        obstacles = [(pos[:2], PROPS[other].footprint_radius_m) for other in self.env.task_object.props()
+                     if other != name and abs((pos := self.body_pose(other)[0])[2] - center[2]) < 0.1]
+        return plan_grasp(self.ik, side, PROPS[name], center, yaw, carry_m=carry_m, obstacles=obstacles, **kwargs)
+
+    def look_and_pick(self, name: str, carry_m=(0.0, 0.0, 0.24), side: str | None = None,
+                      grasp: Grasp | None = None, pre_rise_m: tuple[float, float] = (0.03, 0.06),
+                      via: list[np.ndarray] | None = None) -> Iterator[Segment]:
+        """Saccade to the object and reach for it (the hand sets off with the saccade or just after the eyes
+        land), grasp with a closing ramp at the end of the approach, carry it by `carry_m` (world, m) and hold."""
+        center, _ = self.body_pose(name)
+        side = side or self.side_for(center)
+        grasp = grasp or self.plan(name, side, carry_m)
+        head_s = self.saccade_s()
+        look = self.looking_at(center)
+        pre = grasp.action(self.ik, look, offset_m=self.uniform(0.06, 0.09))
+        pre[SLOTS[side].position][2] += self.uniform(*pre_rise_m)
+        if self.rng.random() < 0.5:  # reach together with the saccade
+            yield Move(pre, self.uniform(0.6, 0.8), head_s=head_s)
+        else:  # a short fixation first
+            yield Move(look, head_s, head_s=head_s)
+            yield Hold(self.uniform(0.0, 0.15))
+            yield Move(pre, self.uniform(0.55, 0.75))
+        for waypoint in via or []:
+            yield Move(waypoint, self.uniform(0.4, 0.6))
+        yield Hold(self.uniform(0.05, 0.15))  # the arm catches up with the pre-grasp pose
+        yield Move(grasp.action(self.ik, look), self.uniform(0.55, 0.75))
+        # close with a ramp once there (the command crosses 0 halfway), then let the fingers squeeze
+        yield Move(grasp.action(self.ik, look, closed=True), self.uniform(0.2, 0.35))
+        yield Hold(self.uniform(0.15, 0.3))
+        carried = grasp.moved(carry_m).action(self.ik, look, closed=True)
+        yield Move(carried, self.uniform(0.9, 1.3))
+        yield Hold(np.inf)
