@@ -17,7 +17,8 @@ from lerobot_tavis.envs.control import ArmIK
 from lerobot_tavis.envs.objects import PropSpec
 from lerobot_tavis.envs.transforms import axis_angle_quat, quat_multiply
 
-PITCHES_RAD = np.radians((45.0, 60.0, 30.0, 75.0, 15.0))
+PITCHES_RAD = np.radians((45.0, 60.0, 30.0, 75.0, 90.0, 15.0))
+NATURAL_AZIMUTH_RAD = np.pi / 4  # wider azimuths are tried only after every pitch of the natural ones
 MAX_AZIMUTH_RAD = np.pi / 2
 WIDTH_MARGIN_M = 0.012
 FLOOR_CLEARANCE_M = 0.006
@@ -111,18 +112,23 @@ def width_across(prop: PropSpec, yaw_rad: float, direction: np.ndarray) -> float
     return float(np.abs(axes @ direction[:2]) @ prop.size_m[:2])
 
 
-def hand_clearance(grasp: Grasp, obstacles, reach_m: float, finger_thickness_m: float) -> tuple[float, float]:
-    """Gaps (m) between obstacles ((xy centre, footprint radius) pairs) and, seen from above, (1) the hand's
-    path: the segment from the grasp point back along the approach, `reach_m` long; (2) the open fingers."""
+def hand_clearance(grasp: Grasp, obstacles, reach_m: float, finger_thickness_m: float,
+                   hand_half_height_m: float = 0.025) -> tuple[float, float]:
+    """Gaps (m) between obstacles ((xy centre, footprint radius, top z) triples) and (1) the hand's path, the
+    segment from the grasp point back along the approach, `reach_m` long, seen from above, counting only obstacles
+    taller than the hand where it passes them; (2) the open fingers at the grasp point."""
     start = grasp.point[:2]
     back = -grasp.approach[:2] * reach_m
+    rise_per_m = np.tan(grasp.pitch_rad)
     fingers = [start + sign * (grasp.opening_m / 2 + finger_thickness_m) * grasp.closing_direction[:2]
                for sign in (1.0, -1.0)]
     path_gap = finger_gap = np.inf
-    for centre, radius in obstacles:
+    for centre, radius, top_z in obstacles:
         centre = np.asarray(centre)
         t = np.clip(np.dot(centre - start, back) / max(np.dot(back, back), 1e-12), 0.0, 1.0)
-        path_gap = min(path_gap, float(np.linalg.norm(centre - (start + t * back))) - radius)
+        hand_bottom_z = grasp.point[2] + t * reach_m * rise_per_m - hand_half_height_m
+        if hand_bottom_z < top_z:
+            path_gap = min(path_gap, float(np.linalg.norm(centre - (start + t * back))) - radius)
         finger_gap = min(finger_gap, *(float(np.linalg.norm(centre - f)) - radius for f in fingers))
     return path_gap, finger_gap
 
@@ -130,11 +136,12 @@ def hand_clearance(grasp: Grasp, obstacles, reach_m: float, finger_thickness_m: 
 def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad: float,
                carry_m=(0.0, 0.0, 0.2), pitches_rad=PITCHES_RAD, max_azimuth_rad: float = MAX_AZIMUTH_RAD,
                toward_rad: float | None = None, obstacles=(), tolerance_m: float = 0.008) -> Grasp:
-    """The first grasp that (1) keeps the hand's path clear of `obstacles` ((xy, radius) of the other props) and
+    """The first grasp that (1) keeps the hand's path clear of `obstacles` ((xy, radius, top z) of the other
+    props) and
     (2) whose grasp pose and carried pose (grasp point + `carry_m`) are both kinematically reachable, in order
-    of preference: upright hand, azimuth nearest `toward_rad` (default: from the shoulder to the object), the
-    given pitch order. Without such a grasp, the best-scoring one. Azimuths farther than `max_azimuth_rad` from
-    `toward_rad` are not considered."""
+    of preference: upright hand; azimuth within 45° of `toward_rad` (default: from the shoulder to the object);
+    the given pitch order; azimuth nearest `toward_rad`. Without such a grasp, the best-scoring one. Azimuths
+    farther than `max_azimuth_rad` from `toward_rad` are not considered."""
     if toward_rad is None:
         shoulder_y = 0.2 if side == "left" else -0.2
         toward_rad = float(np.arctan2(center[1] - shoulder_y, max(center[0], 0.05)))
@@ -145,21 +152,28 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
                 if abs(np.angle(np.exp(1j * (a - toward_rad)))) <= max_azimuth_rad]
     gripper = ik.robot.gripper
     reach = gripper.grasp_depth_m + FOREARM_CLEARANCE_M
+
+    def preference(candidate):
+        flipped, azimuth, pitch_index = candidate
+        deviation = abs(np.angle(np.exp(1j * (azimuth - toward_rad))))
+        return flipped, deviation > NATURAL_AZIMUTH_RAD, pitch_index, deviation
+
+    candidates = sorted(((f, a, i) for f in (False, True) for a in azimuths for i in range(len(pitches_rad))),
+                        key=preference)
     best, best_score = None, np.inf
-    for flipped in (False, True):
-        for azimuth in azimuths:
-            closing = Grasp(side, point, 0.0, azimuth, flipped).closing_direction
-            opening = min(gripper.stroke_m, width_across(prop, yaw_rad, closing) + PRESHAPE_MARGIN_M)
-            for pitch in pitches_rad:
-                grasp = Grasp(side, point, float(pitch), azimuth, flipped, opening)
-                path_gap, finger_gap = hand_clearance(grasp, obstacles, reach * np.cos(pitch),
-                                                      gripper.finger_thickness_m + gripper.pad_thickness_m)
-                blocked = path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M or finger_gap < CORRIDOR_MARGIN_M
-                score = max(_reach_score(ik, grasp), _reach_score(ik, grasp.moved(carry_m))) + 0.05 * blocked
-                if score < tolerance_m:
-                    return grasp
-                if score < best_score:
-                    best, best_score = grasp, score
+    for flipped, azimuth, pitch_index in candidates:
+        pitch = float(pitches_rad[pitch_index])
+        closing = Grasp(side, point, pitch, azimuth, flipped).closing_direction
+        opening = min(gripper.stroke_m, width_across(prop, yaw_rad, closing) + PRESHAPE_MARGIN_M)
+        grasp = Grasp(side, point, pitch, azimuth, flipped, opening)
+        path_gap, finger_gap = hand_clearance(grasp, obstacles, reach * np.cos(pitch),
+                                              gripper.finger_thickness_m + gripper.pad_thickness_m)
+        blocked = path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M or finger_gap < CORRIDOR_MARGIN_M
+        score = max(_reach_score(ik, grasp), _reach_score(ik, grasp.moved(carry_m))) + 0.05 * blocked
+        if score < tolerance_m:
+            return grasp
+        if score < best_score:
+            best, best_score = grasp, score
     if best is None:
         raise ValueError(f"no approach direction for {prop.name} at yaw {yaw_rad:.2f} rad")
     return best

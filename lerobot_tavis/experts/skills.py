@@ -76,7 +76,8 @@ class SkilledExpert(Expert):
     def plan(self, name: str, side: str, carry_m, **kwargs) -> Grasp:
         """A grasp of prop `name` whose approach avoids the other props near it."""
         center, yaw = self.body_pose(name)
-        obstacles = [(pos[:2], PROPS[other].footprint_radius_m) for other in self.env.task_object.props()
+        obstacles = [(pos[:2], PROPS[other].footprint_radius_m, pos[2] + PROPS[other].height_m / 2)
+                     for other in self.env.task_object.props()
                      if other != name and abs((pos := self.body_pose(other)[0])[2] - center[2]) < 0.1]
         return plan_grasp(self.ik, side, PROPS[name], center, yaw, carry_m=carry_m, obstacles=obstacles, **kwargs)
 
