@@ -1,0 +1,238 @@
+"""The eight TAVIS tasks: layouts within their split's ranges, success rules, prompts, blocked camera, init pose."""
+
+import itertools
+
+import mujoco
+import numpy as np
+import pytest
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs import placement
+from lerobot_tavis.envs.env import WARM_UP_HEAD_STD_RAD, WARM_UP_POSITION_STD_M, TavisEnv, warm_up_action
+from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
+from lerobot_tavis.envs.robots import make_robot
+from lerobot_tavis.envs.tasks import multi_shelf_scan, peeking_box
+from lerobot_tavis.envs.tasks.catalog import SUITES, TASKS, suite_tasks
+from lerobot_tavis.envs.tasks.layout import required_distance
+from lerobot_tavis.envs.tasks.registry import make_task
+from lerobot_tavis.envs.world import build_world
+
+TAVIS_TASKS = [t for suite in SUITES for t in suite_tasks(suite)]
+VARIANTS = ("id", "ood_spatial")
+SEEDS = 200
+
+
+def _world(task_name, variant):
+    task = make_task(task_name, variant)
+    world = build_world(make_robot("gr1t2"), task, image_size=(16, 16))
+    return task, world.model, mujoco.MjData(world.model)
+
+
+def _xy(model, data, body):
+    return data.qpos[model.jnt_qposadr[model.body(body).jntadr[0]]:][:2].copy()
+
+
+def _visible(model, data):
+    return [n for n in (*OBJECT_NAMES, "red_cube") if n in PROPS and _has(model, n) and _xy(model, data, n)[0] > 0]
+
+
+def _has(model, body):
+    try:
+        model.body(body)
+        return True
+    except KeyError:
+        return False
+
+
+def test_suites_hold_the_reference_tasks():
+    assert suite_tasks("tavis_head") == ("conditional_pick", "wait_then_act", "clutter_pick_cube",
+                                         "clutter_pick_lift", "multi_shelf_scan")
+    assert suite_tasks("tavis_hands") == ("peeking_box", "occluded_reach", "blocked_clutter_pick_cube")
+    for name in TAVIS_TASKS:
+        assert TASKS[name].splits == ("id", "ood_spatial", "ood_init_pose")
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+@pytest.mark.parametrize("task_name", ["clutter_pick_lift", "clutter_pick_cube", "blocked_clutter_pick_cube"])
+def test_clutter_layouts_stay_in_range_and_separated(task_name, variant):
+    task, model, data = _world(task_name, variant)
+    region, min_sep = task.variant.region, task.variant.min_separation_m
+    rng = np.random.default_rng(0)
+    for _ in range(SEEDS):
+        task.initialize_episode(model, data, rng)
+        names = _visible(model, data)
+        assert len(names) == 5  # cube tasks: four YCB objects and the cube
+        for name in names:
+            assert region.contains(_xy(model, data, name))
+        for a, b in itertools.combinations(names, 2):
+            distance = np.linalg.norm(_xy(model, data, a) - _xy(model, data, b))
+            assert distance > required_distance(min_sep, PROPS[a].footprint_radius_m, PROPS[b].footprint_radius_m)
+        assert task.target in names
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_conditional_pick_layout(variant):
+    task, model, data = _world("conditional_pick", variant)
+    rng = np.random.default_rng(1)
+    colours = set()
+    for _ in range(SEEDS):
+        task.initialize_episode(model, data, rng)
+        assert task.variant.left_zone.contains(_xy(model, data, task.left_object))
+        assert task.variant.right_zone.contains(_xy(model, data, task.right_object))
+        card = data.mocap_pos[model.body("cue_card").mocapid[0]]
+        assert task.variant.card_zone.contains(card[:2])
+        assert task.target == (task.left_object if task.card_is_red else task.right_object)
+        assert len(_visible(model, data)) == 2
+        colours.add(task.card_is_red)
+    assert colours == {True, False}
+
+
+@pytest.mark.parametrize("variant,delays", [("id", (2.0, 5.0)), ("ood_spatial", (2.0, 8.0))])
+def test_wait_then_act_layout_and_delay(variant, delays):
+    task, model, data = _world("wait_then_act", variant)
+    rng = np.random.default_rng(2)
+    for _ in range(SEEDS):
+        task.initialize_episode(model, data, rng)
+        assert delays[0] <= task.delay_s <= delays[1] and task.green_step == int(task.delay_s * 20)
+        assert task.variant.object_zone.contains(_xy(model, data, task.target))
+        assert task.variant.light_zone.contains(data.mocap_pos[model.body("signal_light").mocapid[0]][:2])
+        assert _visible(model, data) == [task.target] and not task.is_green
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_multi_shelf_scan_layout(variant):
+    task, model, data = _world("multi_shelf_scan", variant)
+    rng = np.random.default_rng(3)
+    for _ in range(SEEDS):
+        task.initialize_episode(model, data, rng)
+        assert len(set(task.slots.values())) == 5
+        for name, (shelf, slot_y) in task.slots.items():
+            x, y = _xy(model, data, name)
+            assert multi_shelf_scan.SLOT_X_CLAMP[0] - 1e-9 <= x <= multi_shelf_scan.SLOT_X_CLAMP[1] + 1e-9
+            assert abs(y - slot_y) <= task.variant.jitter_y_m + 1e-9 and abs(y) <= 0.32 + 1e-9
+        assert task.prompt in multi_shelf_scan.SHELF_PROMPTS[task.target]
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_peeking_box_layout(variant):
+    task, model, data = _world("peeking_box", variant)
+    rng = np.random.default_rng(4)
+    sides = set()
+    for _ in range(SEEDS):
+        task.initialize_episode(model, data, rng)
+        v = task.variant
+        assert v.box_x[0] <= task.box_center[0] <= v.box_x[1] and v.box_y[0] <= task.box_center[1] <= v.box_y[1]
+        assert v.box_yaw_rad[0] <= task.box_yaw <= v.box_yaw_rad[1]
+        local = peeking_box.matrix_from_quat(peeking_box.axis_angle_quat((0, 0, 1), -task.box_yaw))[:2, :2] @ (
+            _xy(model, data, task.target) - task.box_center)
+        assert v.object_dx[0] - 1e-9 <= local[0] <= v.object_dx[1] + 1e-9
+        assert v.object_dy[0] - 1e-9 <= local[1] <= v.object_dy[1] + 1e-9
+        open_geom = model.geom(f"box/{task.open_side}").id
+        assert model.geom_contype[open_geom] == 0 and model.geom_group[open_geom] == 3
+        sides.add(task.open_side)
+    assert sides == {"+y", "-y"}
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_occluded_reach_layout(variant):
+    task, model, data = _world("occluded_reach", variant)
+    rng = np.random.default_rng(5)
+    for _ in range(SEEDS):
+        task.initialize_episode(model, data, rng)
+        assert task.variant.object_zone.contains(_xy(model, data, task.target))
+        assert _visible(model, data) == [task.target]
+
+
+@pytest.mark.parametrize("task_name", TAVIS_TASKS)
+def test_success_fires_above_the_threshold_and_not_below(task_name):
+    task, model, data = _world(task_name, "id")
+    task.initialize_episode(model, data, np.random.default_rng(0))
+    if task_name == "wait_then_act":
+        task.after_step(model, data, task.green_step)
+    if task_name == "multi_shelf_scan":
+        inside, outside = (0.50, 0.0, 1.2), (0.40, 0.0, 1.2)
+    else:
+        threshold = task.success_height_m
+        inside, outside = (0.4, 0.0, threshold - 0.01), (0.4, 0.0, threshold + 0.01)
+    for where, expected in ((inside, False), (outside, True)):
+        placement.set_free_pose(model, data, task.target, where)
+        mujoco.mj_forward(model, data)
+        assert task.is_success(data) == expected, where
+    dof = model.jnt_dofadr[model.body(task.target).jntadr[0]]
+    data.qvel[dof] = 1.5  # moving too fast
+    mujoco.mj_forward(model, data)
+    assert not task.is_success(data)
+
+
+def test_wait_then_act_counts_success_only_once_green():
+    task, model, data = _world("wait_then_act", "id")
+    task.initialize_episode(model, data, np.random.default_rng(0))
+    placement.set_free_pose(model, data, task.target, (0.4, 0.0, 1.3))
+    mujoco.mj_forward(model, data)
+    task.after_step(model, data, task.green_step - 1)
+    assert not task.is_green and not task.is_success(data)
+    task.after_step(model, data, task.green_step)
+    assert task.is_green and task.is_success(data)
+
+
+def test_blocked_head_camera_is_black_and_the_head_still_moves(small_env):
+    env = small_env(task="blocked_clutter_pick_cube", camera_mode="head_wrist")
+    obs, _ = env.reset(seed=0)
+    assert not obs["pixels"]["head"].any()
+    assert obs["pixels"]["left_wrist"].any()
+    action = canonical.rest_action()
+    action[canonical.HEAD_YAW] = 0.5
+    for _ in range(15):
+        obs, *_ = env.step(action)
+    assert not obs["pixels"]["head"].any() and obs["agent_pos"][canonical.HEAD_YAW] == pytest.approx(0.5, abs=0.02)
+    open_env = small_env(task="clutter_pick_cube", camera_mode="headcam")
+    assert open_env.reset(seed=0)[0]["pixels"]["head"].any()
+
+
+@pytest.mark.parametrize("task_name", TAVIS_TASKS)
+def test_seed_reproduces_layout_and_prompt_and_objects_are_still(small_env, task_name):
+    first, second = (small_env(task=task_name, camera_mode="fixedcam", image_size=(16, 16)) for _ in range(2))
+    first.reset(seed=11)
+    second.reset(seed=11)
+    np.testing.assert_array_equal(first.data.qpos, second.data.qpos)
+    assert first.task_description == second.task_description
+    for prop in first.task_object.props():
+        assert placement.body_speed(first.model, first.data, prop) < 0.01
+
+
+@pytest.mark.parametrize("task_name", ["clutter_pick_lift", "multi_shelf_scan"])
+def test_prompts_vary_with_the_seed(small_env, task_name):
+    env = small_env(task=task_name, camera_mode="fixedcam", image_size=(16, 16))
+    prompts = {env.reset(seed=seed)[0] and env.task_description for seed in range(30)}
+    assert len(prompts) >= 8 and prompts <= set(TASKS[task_name].prompts)
+
+
+def test_warm_up_noise_has_the_reference_spread():
+    rng = np.random.default_rng(0)
+    samples = np.array([warm_up_action(rng) for _ in range(4000)]) - canonical.rest_action()
+    positions = samples[:, [0, 1, 2, 7, 8, 9]]
+    assert positions.std(axis=0) == pytest.approx(np.full(6, WARM_UP_POSITION_STD_M), rel=0.06)
+    assert samples[:, [15, 16]].std(axis=0) == pytest.approx(np.full(2, WARM_UP_HEAD_STD_RAD), rel=0.06)
+    np.testing.assert_array_equal(samples[:, 14], 0.0)
+    np.testing.assert_array_equal(samples[:, [3, 4, 5, 6, 10, 11, 12, 13, 17, 18]], 0.0)
+
+
+def test_ood_init_pose_starts_from_the_id_scene_with_a_perturbed_robot(small_env):
+    nominal = small_env(task="clutter_pick_lift", split="id", camera_mode="fixedcam")
+    perturbed = small_env(task="clutter_pick_lift", split="ood_init_pose", camera_mode="fixedcam")
+    id_obs, _ = nominal.reset(seed=5)
+    ood_obs, _ = perturbed.reset(seed=5)
+    for name in OBJECT_NAMES:
+        np.testing.assert_allclose(_xy(nominal.model, nominal.data, name),
+                                   _xy(perturbed.model, perturbed.data, name), atol=2e-3)
+    assert nominal.task_description == perturbed.task_description
+    hands = [0, 1, 2, 7, 8, 9]
+    moved = np.abs(ood_obs["agent_pos"][hands] - id_obs["agent_pos"][hands])
+    assert moved.max() > 0.02 and perturbed._steps == 0
+
+
+def test_task_metadata_is_readable_without_a_simulator():
+    info = TASKS["multi_shelf_scan"]
+    assert info.suite == "tavis_head" and len(info.prompts) == 15 and "0.435" in info.success_rule
+    assert TASKS["peeking_box"].prompts == ("Retrieve the object from inside the box.",)
+    assert TavisEnv(task="peeking_box")._sim is None
