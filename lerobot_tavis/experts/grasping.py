@@ -20,7 +20,7 @@ from lerobot_tavis.envs.transforms import axis_angle_quat, quat_multiply
 PITCHES_RAD = np.radians((45.0, 60.0, 30.0, 75.0, 90.0, 15.0))
 NATURAL_AZIMUTH_RAD = np.pi / 4  # wider azimuths are tried only after every pitch of the natural ones
 MAX_AZIMUTH_RAD = np.pi / 2
-WIDTH_MARGIN_M = 0.012
+MIN_FINGER_CLEARANCE_M = 0.002  # total; a wide side is still tried, after the narrow one
 FLOOR_CLEARANCE_M = 0.006
 CORRIDOR_MARGIN_M = 0.005
 PRESHAPE_MARGIN_M = 0.03  # open this much wider than the object
@@ -95,7 +95,7 @@ def closing_azimuths(prop: PropSpec, yaw_rad: float, stroke_m: float, toward_rad
         return [toward_rad + offset for offset in CYLINDER_AZIMUTH_OFFSETS_RAD]
     options = []
     for closing_axis, width in ((0, prop.size_m[0]), (1, prop.size_m[1])):
-        if width > stroke_m - WIDTH_MARGIN_M:
+        if width > stroke_m - MIN_FINGER_CLEARANCE_M:
             continue
         approach = yaw_rad + closing_axis * np.pi / 2 + np.pi / 2  # perpendicular to the closing direction
         if np.cos(approach - toward_rad) < 0:
@@ -141,15 +141,15 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
     (2) whose grasp pose and carried pose (grasp point + `carry_m`) are both kinematically reachable, in order
     of preference: upright hand; azimuth within 45° of `toward_rad` (default: from the shoulder to the object);
     the given pitch order; azimuth nearest `toward_rad`. Without such a grasp, the best-scoring one. Azimuths
-    farther than `max_azimuth_rad` from `toward_rad` are not considered."""
+    farther than `max_azimuth_rad` from `toward_rad` are considered only when there is no other."""
     if toward_rad is None:
         shoulder_y = 0.2 if side == "left" else -0.2
         toward_rad = float(np.arctan2(center[1] - shoulder_y, max(center[0], 0.05)))
     bottom = center[2] - prop.height_m / 2
     point = center.copy()
     point[2] = max(center[2], bottom + ik.robot.gripper.pad_length_m / 2 + FLOOR_CLEARANCE_M)
-    azimuths = [a for a in closing_azimuths(prop, yaw_rad, ik.robot.gripper.stroke_m, toward_rad)
-                if abs(np.angle(np.exp(1j * (a - toward_rad)))) <= max_azimuth_rad]
+    options = closing_azimuths(prop, yaw_rad, ik.robot.gripper.stroke_m, toward_rad)
+    azimuths = [a for a in options if abs(np.angle(np.exp(1j * (a - toward_rad)))) <= max_azimuth_rad] or options[:1]
     gripper = ik.robot.gripper
     reach = gripper.grasp_depth_m + FOREARM_CLEARANCE_M
 
@@ -174,6 +174,4 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
             return grasp
         if score < best_score:
             best, best_score = grasp, score
-    if best is None:
-        raise ValueError(f"no approach direction for {prop.name} at yaw {yaw_rad:.2f} rad")
     return best

@@ -72,6 +72,6 @@ class ShelfExpert(SkilledExpert):
         yield from self.scan(points, (0.25, 0.5))
         center, _ = self.body_pose(task.target)
         side = self.side_for(center)
-        grasp = self.plan(task.target, side, PULL_OUT, pitches_rad=np.radians((10.0, 0.0, 20.0, 30.0)),
-                          max_azimuth_rad=0.5, toward_rad=0.0)
-        yield from self.look_and_pick(task.target, PULL_OUT, side=side, grasp=grasp, pre_rise_m=(0.0, 0.01))
+        yield from self.look_and_pick(task.target, PULL_OUT, side=side, pre_rise_m=(0.0, 0.01),
+                                      pitches_rad=np.radians((10.0, 0.0, 20.0, 30.0)), max_azimuth_rad=0.5,
+                                      toward_rad=0.0)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lerobot_tavis.experts.base import Expert
+from lerobot_tavis.experts.hands_tasks import BlockedClutterExpert, OccludedReachExpert, PeekingBoxExpert
 from lerobot_tavis.experts.head_tasks import ClutterExpert, ConditionalPickExpert, ShelfExpert, WaitThenActExpert
 
 EXPERTS: dict[str, type[Expert]] = {
@@ -15,6 +16,9 @@ EXPERTS: dict[str, type[Expert]] = {
     "clutter_pick_cube": ClutterExpert,
     "clutter_pick_lift": ClutterExpert,
     "multi_shelf_scan": ShelfExpert,
+    "peeking_box": PeekingBoxExpert,
+    "occluded_reach": OccludedReachExpert,
+    "blocked_clutter_pick_cube": BlockedClutterExpert,
 }
 
 

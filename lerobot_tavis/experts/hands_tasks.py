@@ -1,0 +1,90 @@
+"""Demonstrators for the TAVIS-Hands tasks: a wrist camera goes to look before the arm commits to an approach."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs.scene import TABLE_TOP_Z
+from lerobot_tavis.envs.tasks import occluded_reach, peeking_box
+from lerobot_tavis.envs.transforms import axis_angle_quat, matrix_from_quat
+from lerobot_tavis.experts.base import Hold, Move, Segment
+from lerobot_tavis.experts.head_tasks import LIFT, ClutterExpert
+from lerobot_tavis.experts.skills import SkilledExpert
+
+HIGH_LIFT = (0.0, 0.0, 0.29)  # success needs the origin above 1.25 m
+SIDE_OF = {"+y": "left", "-y": "right"}
+
+
+class PeekingBoxExpert(SkilledExpert):
+    """Look at the box, peek into both sides with the wrist cameras, then reach in through the open side."""
+
+    def behaviour(self) -> Iterator[Segment]:
+        task = self.env.task_object
+        rotation = matrix_from_quat(axis_angle_quat((0, 0, 1), task.box_yaw))
+
+        def box_point(dx, dy, z):
+            return np.array([*(task.box_center + rotation[:2, :2] @ (dx, dy)), z])
+
+        yield Hold(self.uniform(0.2, 0.4))
+        yield from self.fixate(box_point(0.0, 0.0, peeking_box.BOTTOM_Z + peeking_box.HEIGHT), (0.3, 0.5))
+        for opening in self.rng.permutation(["+y", "-y"]):
+            sign = 1.0 if opening == "+y" else -1.0
+            side = SIDE_OF[opening]
+            outside = box_point(self.uniform(-0.05, 0.0), sign * (peeking_box.HALF_WIDTH + 0.17), 1.13)
+            inside = box_point(self.uniform(-0.02, 0.04), 0.0, TABLE_TOP_Z + 0.04)
+            yield from self.fixate(outside, (0.1, 0.2))
+            yield from self.peek(side, outside, inside)
+            if opening == task.open_side:
+                break
+            yield Move(self.at_rest(side=side), self.uniform(0.6, 0.9))
+        side = SIDE_OF[task.open_side]
+        sign = 1.0 if task.open_side == "+y" else -1.0
+        into_box = task.box_yaw - sign * np.pi / 2  # approach direction through the opening
+        out = np.array([*(rotation[:2, :2] @ (0.0, sign * 0.22)), 0.0])  # back out through the opening
+        yield from self.look_and_pick(task.target, side=side, pre_rise_m=(0.0, 0.01),
+                                      carry_path=[out, out + HIGH_LIFT], toward_rad=float(into_box),
+                                      max_azimuth_rad=0.6, pitches_rad=np.radians((15.0, 25.0, 5.0, 35.0)))
+
+
+class OccludedReachExpert(SkilledExpert):
+    """Look at the screen, bring a hand to its edge so the wrist camera sees behind it, then reach around."""
+
+    def behaviour(self) -> Iterator[Segment]:
+        task = self.env.task_object
+        target, _ = self.body_pose(task.target)
+        yield Hold(self.uniform(0.2, 0.4))
+        yield from self.fixate((occluded_reach.SCREEN_X, 0.0, 1.2), (0.3, 0.5))
+        side = self.side_for(target) if abs(target[1]) > 0.05 else ("left", "right")[self.rng.integers(2)]
+        sign = 1.0 if side == "left" else -1.0
+        order = [side] if self.rng.random() < 0.6 else [("right" if side == "left" else "left"), side]
+        for peeking in order:
+            s = 1.0 if peeking == "left" else -1.0
+            edge = np.array([occluded_reach.SCREEN_X - 0.03, s * self.uniform(0.17, 0.21), self.uniform(1.18, 1.24)])
+            behind = np.array([self.uniform(0.42, 0.48), s * self.uniform(-0.02, 0.06), TABLE_TOP_Z + 0.03])
+            yield from self.fixate(edge, (0.1, 0.2))
+            yield from self.peek(peeking, edge, behind)
+            if peeking != side:
+                yield Move(self.at_rest(side=peeking), self.uniform(0.6, 0.9))
+        toward = float(np.arctan2(target[1] - sign * 0.18, target[0] - occluded_reach.SCREEN_X))
+        yield from self.look_and_pick(task.target, HIGH_LIFT, side=side, toward_rad=toward, max_azimuth_rad=0.8)
+
+
+class BlockedClutterExpert(ClutterExpert):
+    """The head camera is black: sweep a hand over the table with its wrist camera looking down, then pick."""
+
+    def behaviour(self) -> Iterator[Segment]:
+        task = self.env.task_object
+        cube, _ = self.body_pose(task.target)
+        yield Hold(self.uniform(0.2, 0.4))
+        side = self.side_for(cube)
+        sign = 1.0 if side == "left" else -1.0
+        stops = sorted(self.rng.uniform(-0.05, 0.25, size=int(self.rng.integers(2, 4))) * sign, reverse=sign > 0)
+        for y in [*stops, cube[1]]:
+            x = self.uniform(0.36, 0.44) if y != cube[1] else cube[0]
+            over = np.array([x - 0.12, y, TABLE_TOP_Z + 0.30])
+            yield from self.peek(side, over, (x, y, TABLE_TOP_Z), duration_s=(0.5, 0.8), dwell_s=(0.3, 0.5),
+                                 base=self.looking_at((x, y, TABLE_TOP_Z)))
+        yield from self.look_and_pick(task.target, LIFT, side=side)

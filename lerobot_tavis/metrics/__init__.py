@@ -1,0 +1,1 @@
+"""Benchmark metrics: success statistics and GALT. Numpy only."""

@@ -1,0 +1,20 @@
+"""Success statistics."""
+
+from __future__ import annotations
+
+import math
+
+Z_95 = 1.96
+
+
+def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, float]:
+    """Wilson score interval of a success rate (reference §7.5), clipped to [0, 1]; (0, 0) when n = 0."""
+    if not 0 <= successes <= n:
+        raise ValueError(f"successes must be within 0..n={n}, got {successes}")
+    if n == 0:
+        return 0.0, 0.0
+    p = successes / n
+    denominator = 1 + z**2 / n
+    centre = (p + z**2 / (2 * n)) / denominator
+    half_width = z / denominator * math.sqrt(p * (1 - p) / n + z**2 / (4 * n**2))
+    return max(0.0, centre - half_width), min(1.0, centre + half_width)
