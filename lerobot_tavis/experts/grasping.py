@@ -22,6 +22,7 @@ NATURAL_AZIMUTH_RAD = np.pi / 4  # wider azimuths are tried only after every pit
 MAX_AZIMUTH_RAD = np.pi / 2
 MIN_FINGER_CLEARANCE_M = 0.002  # total; a wide side is still tried, after the narrow one
 FLOOR_CLEARANCE_M = 0.006
+PAD_ABOVE_TOP_M = 0.004  # pad tips may stick out above the object's top by this much
 CORRIDOR_MARGIN_M = 0.005
 PRESHAPE_MARGIN_M = 0.03  # open this much wider than the object
 FOREARM_CLEARANCE_M = 0.08
@@ -133,6 +134,17 @@ def hand_clearance(grasp: Grasp, obstacles, reach_m: float, finger_thickness_m: 
     return path_gap, finger_gap
 
 
+def palm_clears(grasp: Grasp, gripper, top_z: float, half_extent_xy, yaw_rad: float) -> bool:
+    """Whether the palm's leading edge passes above the object's top or beyond its far side."""
+    behind = gripper.grasp_depth_m - gripper.mount_offset_m - gripper.palm_length_m  # pads' middle to palm face
+    half_thickness = gripper.palm_half_thickness_m
+    above = behind * np.sin(grasp.pitch_rad) - half_thickness * np.cos(grasp.pitch_rad) + grasp.point[2] - top_z
+    direction = grasp.approach[:2] / max(np.linalg.norm(grasp.approach[:2]), 1e-9)
+    reach_back = abs(direction[0]) * half_extent_xy[0] + abs(direction[1]) * half_extent_xy[1]
+    beyond = behind * np.cos(grasp.pitch_rad) - half_thickness * np.sin(grasp.pitch_rad) - reach_back
+    return bool(above > CORRIDOR_MARGIN_M or beyond > CORRIDOR_MARGIN_M)
+
+
 def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad: float,
                carry_m=(0.0, 0.0, 0.2), pitches_rad=PITCHES_RAD, max_azimuth_rad: float = MAX_AZIMUTH_RAD,
                toward_rad: float | None = None, obstacles=(), tolerance_m: float = 0.008) -> Grasp:
@@ -145,9 +157,11 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
     if toward_rad is None:
         shoulder_y = 0.2 if side == "left" else -0.2
         toward_rad = float(np.arctan2(center[1] - shoulder_y, max(center[0], 0.05)))
-    bottom = center[2] - prop.height_m / 2
+    bottom, top = center[2] - prop.height_m / 2, center[2] + prop.height_m / 2
+    pad = ik.robot.gripper.pad_length_m
     point = center.copy()
-    point[2] = max(center[2], bottom + ik.robot.gripper.pad_length_m / 2 + FLOOR_CLEARANCE_M)
+    # pads on the upper part of the object (the palm then stays clear of its top), never touching the surface below
+    point[2] = max(top - pad / 2 + PAD_ABOVE_TOP_M, bottom + pad / 2 + FLOOR_CLEARANCE_M)
     options = closing_azimuths(prop, yaw_rad, ik.robot.gripper.stroke_m, toward_rad)
     azimuths = [a for a in options if abs(np.angle(np.exp(1j * (a - toward_rad)))) <= max_azimuth_rad] or options[:1]
     gripper = ik.robot.gripper
@@ -168,7 +182,8 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
         grasp = Grasp(side, point, pitch, azimuth, flipped, opening)
         path_gap, finger_gap = hand_clearance(grasp, obstacles, reach * np.cos(pitch),
                                               gripper.finger_thickness_m + gripper.pad_thickness_m)
-        blocked = path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M or finger_gap < CORRIDOR_MARGIN_M
+        blocked = (path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M or finger_gap < CORRIDOR_MARGIN_M
+                   or not palm_clears(grasp, gripper, top, prop.half_extent_xy(yaw_rad), yaw_rad))
         score = max(_reach_score(ik, grasp), _reach_score(ik, grasp.moved(carry_m))) + 0.05 * blocked
         if score < tolerance_m:
             return grasp

@@ -92,6 +92,7 @@ class GripperGeometry:
     squeeze_force_n: float = 40.0
     servo_kp: float = 2000.0
     speed_m_s: float = 0.12  # setpoint ramp per finger: a commanded jump closes over ~0.2-0.4 s
+    palm_half_thickness_m: float = 0.02  # along the hand's x
     finger_half_x_m: float = 0.011
     finger_thickness_m: float = 0.010
     pad_thickness_m: float = 0.004
@@ -115,7 +116,7 @@ def add_gripper(spec: mujoco.MjSpec, hand: mujoco.MjsBody, side: str, g: Gripper
     """
     z_palm = -g.mount_offset_m
     add_box(hand, f"{side}_palm", (0.0, 0.0, z_palm - g.palm_length_m / 2),
-            (0.02, g.palm_half_width_m, g.palm_length_m / 2), rgba)
+            (g.palm_half_thickness_m, g.palm_half_width_m, g.palm_length_m / 2), rgba)
     z_root = z_palm - g.palm_length_m
     finger_mid = z_root - g.finger_length_m / 2
     pad_mid = z_root - g.finger_length_m + g.pad_length_m / 2
