@@ -18,6 +18,8 @@ from lerobot_tavis.envs.objects import PropSpec
 from lerobot_tavis.envs.transforms import axis_angle_quat, quat_multiply
 
 PITCHES_RAD = np.radians((45.0, 60.0, 30.0, 75.0, 90.0, 15.0))
+STEEP_PITCHES_RAD = np.radians((75.0, 90.0, 60.0, 45.0, 30.0))
+TIGHT_CLEARANCE_M = 0.015  # per side, below which the steep pitches are tried first
 NATURAL_AZIMUTH_RAD = np.pi / 4  # wider azimuths are tried only after every pitch of the natural ones
 MAX_AZIMUTH_RAD = np.pi / 2
 MIN_FINGER_CLEARANCE_M = 0.002  # total; a wide side is still tried, after the narrow one
@@ -172,6 +174,10 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
         deviation = abs(np.angle(np.exp(1j * (azimuth - toward_rad))))
         return flipped, deviation > NATURAL_AZIMUTH_RAD, pitch_index, deviation
 
+    if pitches_rad is PITCHES_RAD and min(width_across(prop, yaw_rad, Grasp(side, point, 0.0, a, False)
+                                                           .closing_direction) for a in azimuths) > \
+            gripper.stroke_m - 2 * TIGHT_CLEARANCE_M:
+        pitches_rad = STEEP_PITCHES_RAD  # little room beside the object: come down from above
     candidates = sorted(((f, a, i) for f in (False, True) for a in azimuths for i in range(len(pitches_rad))),
                         key=preference)
     best, best_score = None, np.inf

@@ -96,7 +96,7 @@ class SkilledExpert(Expert):
         return plan_grasp(self.ik, side, PROPS[name], center, yaw, carry_m=carry_m, obstacles=obstacles, **kwargs)
 
     def look_and_pick(self, name: str, carry_m=(0.0, 0.0, 0.24), side: str | None = None,
-                      pre_rise_m: tuple[float, float] = (0.03, 0.06),
+                      pre_rise_m: tuple[float, float] = (0.05, 0.08),
                       carry_path: list | None = None, attempts: int = 3, **plan_kwargs) -> Iterator[Segment]:
         """Saccade to the object and reach for it (the hand sets off with the saccade or just after the eyes
         land), grasp with a closing ramp at the end of the approach, carry it by `carry_m` (world, m; or through
@@ -110,7 +110,7 @@ class SkilledExpert(Expert):
             grasp = self.plan(name, side, (carry_path or [carry_m])[-1], **plan_kwargs)
             head_s = self.saccade_s()
             look = self.looking_at(center)
-            pre = grasp.action(self.ik, look, offset_m=self.uniform(0.06, 0.09))
+            pre = grasp.action(self.ik, look, offset_m=self.uniform(0.08, 0.11))
             pre[slots.position][2] += self.uniform(*pre_rise_m)
             if self.rng.random() < 0.5:  # reach together with the saccade
                 yield Move(pre, self.uniform(0.6, 0.8), head_s=head_s)
