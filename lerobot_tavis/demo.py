@@ -45,8 +45,8 @@ def look_and_reach_script(env: TavisEnv, target: str) -> tuple[ActionScript, flo
         Keyframe(pre, 0.8),
         Keyframe(grasp.action(ik, look), 0.8),
         Keyframe(grasp.action(ik, look, closed=True), 0.8),
-        Keyframe(grasp.lifted(0.2).action(ik, look, closed=True), 1.5),
-        Keyframe(grasp.lifted(0.2).action(ik, look, closed=True), 0.7),
+        Keyframe(grasp.carried().action(ik, look, closed=True), 1.5),
+        Keyframe(grasp.carried().action(ik, look, closed=True), 0.7),
     ]
     closed_at = sum(k.duration_s for k in keyframes[:7])
     return ActionScript(canonical.rest_action(), keyframes), closed_at

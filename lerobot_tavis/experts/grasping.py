@@ -20,6 +20,8 @@ from lerobot_tavis.envs.transforms import axis_angle_quat, quat_multiply
 PITCHES_RAD = np.radians((45.0, 60.0, 30.0, 75.0, 90.0, 15.0))
 STEEP_PITCHES_RAD = np.radians((75.0, 90.0, 60.0, 45.0, 30.0))
 TIGHT_CLEARANCE_M = 0.015  # per side, below which the steep pitches are tried first
+CARRY_TOLERANCE_M = 0.04
+CARRY_PULL_M = 0.08  # the carried pose only has to get the object past the success line
 NATURAL_AZIMUTH_RAD = np.pi / 4  # wider azimuths are tried only after every pitch of the natural ones
 MAX_AZIMUTH_RAD = np.pi / 2
 MIN_FINGER_CLEARANCE_M = 0.002  # total; a wide side is still tried, after the narrow one
@@ -39,6 +41,8 @@ class Grasp:
     azimuth_rad: float  # approach direction about world z (0 = forward)
     flipped: bool
     opening_m: float = 1.0  # pre-grasp opening (pre-shaped to the object; clipped to the stroke)
+    carry_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.2)  # where the object goes once held (world, m)
+    carry_pitch_rad: float | None = None  # approach pitch while carrying (None: unchanged)
 
     @property
     def approach(self) -> np.ndarray:
@@ -63,6 +67,12 @@ class Grasp:
 
     def lifted(self, height_m: float) -> Grasp:
         return self.moved((0.0, 0.0, height_m))
+
+    def carried(self) -> Grasp:
+        """The hand pose holding the object at its carry position (the carry offset and pitch chosen by the
+        planner)."""
+        pitch = self.pitch_rad if self.carry_pitch_rad is None else self.carry_pitch_rad
+        return replace(self.moved(self.carry_offset_m), pitch_rad=pitch)
 
     def ee_pose(self, ik: ArmIK, offset_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Canonical end-effector position and quaternion that put the pads on the grasp point, backed off
@@ -136,23 +146,48 @@ def hand_clearance(grasp: Grasp, obstacles, reach_m: float, finger_thickness_m: 
     return path_gap, finger_gap
 
 
-def palm_clears(grasp: Grasp, gripper, top_z: float, half_extent_xy, yaw_rad: float) -> bool:
-    """Whether the palm's leading edge passes above the object's top or beyond its far side."""
+def palm_clearances(grasp: Grasp, gripper, top_z: float, center: np.ndarray, half_extent_xy) -> tuple[float, float]:
+    """How far (m) the palm's leading edge stays above the object's top, and behind its near side."""
     behind = gripper.grasp_depth_m - gripper.mount_offset_m - gripper.palm_length_m  # pads' middle to palm face
     half_thickness = gripper.palm_half_thickness_m
     above = behind * np.sin(grasp.pitch_rad) - half_thickness * np.cos(grasp.pitch_rad) + grasp.point[2] - top_z
     direction = grasp.approach[:2] / max(np.linalg.norm(grasp.approach[:2]), 1e-9)
-    reach_back = abs(direction[0]) * half_extent_xy[0] + abs(direction[1]) * half_extent_xy[1]
-    beyond = behind * np.cos(grasp.pitch_rad) - half_thickness * np.sin(grasp.pitch_rad) - reach_back
-    return bool(above > CORRIDOR_MARGIN_M or beyond > CORRIDOR_MARGIN_M)
+    near_side = abs(direction[0]) * half_extent_xy[0] + abs(direction[1]) * half_extent_xy[1] - np.dot(
+        center[:2] - grasp.point[:2], direction)
+    beyond = behind * np.cos(grasp.pitch_rad) - half_thickness * np.sin(grasp.pitch_rad) - near_side
+    return float(above), float(beyond)
+
+
+def clear_the_palm(grasp: Grasp, gripper, top_z: float, center: np.ndarray, half_extent_xy) -> Grasp | None:
+    """`grasp`, moved back along the approach (by at most a third of the pads' length) if that keeps the palm
+    clear of a long object's near side; None if the palm would hit the object."""
+    above, beyond = palm_clearances(grasp, gripper, top_z, center, half_extent_xy)
+    if max(above, beyond) > CORRIDOR_MARGIN_M:
+        return grasp
+    shift = CORRIDOR_MARGIN_M - beyond + 1e-4
+    if shift > gripper.pad_length_m / 3:
+        return None
+    direction = np.array([*(grasp.approach[:2] / max(np.linalg.norm(grasp.approach[:2]), 1e-9)), 0.0])
+    return replace(grasp, point=grasp.point - shift * direction)
+
+
+def carry_options(grasp: Grasp, carry_m) -> list[Grasp]:
+    """Ways to hold the object at its carry position: as grasped, with a flatter hand, or a little closer to
+    the body (all get it past the success line)."""
+    carry = np.asarray(carry_m, dtype=float)
+    nearer = carry + (-CARRY_PULL_M, 0.0, 0.0) if carry[2] > 0.1 else carry
+    pitches = (None, max(grasp.pitch_rad - 0.5, 0.0), 0.0)
+    return [replace(grasp, carry_offset_m=tuple(offset), carry_pitch_rad=pitch)
+            for offset in (carry, nearer) for pitch in pitches]
 
 
 def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad: float,
                carry_m=(0.0, 0.0, 0.2), pitches_rad=PITCHES_RAD, max_azimuth_rad: float = MAX_AZIMUTH_RAD,
-               toward_rad: float | None = None, obstacles=(), tolerance_m: float = 0.008) -> Grasp:
+               toward_rad: float | None = None, obstacles=(), tolerance_m: float = 0.008,
+               carry_tolerance_m: float = CARRY_TOLERANCE_M) -> Grasp:
     """The first grasp that (1) keeps the hand's path clear of `obstacles` ((xy, radius, top z) of the other
-    props) and
-    (2) whose grasp pose and carried pose (grasp point + `carry_m`) are both kinematically reachable, in order
+    props), (2) whose grasp pose is kinematically reachable within `tolerance_m` and (3) whose carried pose
+    (grasp point + `carry_m`) is reachable within `carry_tolerance_m`, in order
     of preference: upright hand; azimuth within 45° of `toward_rad` (default: from the shoulder to the object);
     the given pitch order; azimuth nearest `toward_rad`. Without such a grasp, the best-scoring one. Azimuths
     farther than `max_azimuth_rad` from `toward_rad` are considered only when there is no other."""
@@ -185,14 +220,23 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
         pitch = float(pitches_rad[pitch_index])
         closing = Grasp(side, point, pitch, azimuth, flipped).closing_direction
         opening = min(gripper.stroke_m, width_across(prop, yaw_rad, closing) + PRESHAPE_MARGIN_M)
-        grasp = Grasp(side, point, pitch, azimuth, flipped, opening)
+        grasp = clear_the_palm(Grasp(side, point, pitch, azimuth, flipped, opening), gripper, top, center,
+                               prop.half_extent_xy(yaw_rad))
+        if grasp is None:
+            continue
         path_gap, finger_gap = hand_clearance(grasp, obstacles, reach * np.cos(pitch),
                                               gripper.finger_thickness_m + gripper.pad_thickness_m)
-        blocked = (path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M or finger_gap < CORRIDOR_MARGIN_M
-                   or not palm_clears(grasp, gripper, top, prop.half_extent_xy(yaw_rad), yaw_rad))
-        score = max(_reach_score(ik, grasp), _reach_score(ik, grasp.moved(carry_m))) + 0.05 * blocked
-        if score < tolerance_m:
-            return grasp
+        blocked = path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M or finger_gap < CORRIDOR_MARGIN_M
+        grasp_error = _reach_score(ik, grasp)
+        if blocked or grasp_error > tolerance_m:
+            score = grasp_error + 0.05 * blocked + 0.05
+        else:
+            carry_error, grasp = min(((_reach_score(ik, option.carried()), option)
+                                      for option in carry_options(grasp, carry_m)), key=lambda pair: pair[0])
+            if carry_error < carry_tolerance_m:
+                return grasp
+            score = grasp_error + carry_error
+
         if score < best_score:
             best, best_score = grasp, score
     return best

@@ -126,8 +126,9 @@ class SkilledExpert(Expert):
             if self.holding(side, name):
                 break
             yield Move(pre, self.uniform(0.5, 0.7))  # open and back off, then try again
-        for offset in carry_path or [carry_m]:
+        for offset in (carry_path or [])[:-1]:
             yield Move(grasp.moved(offset).action(self.ik, look, closed=True), self.uniform(0.9, 1.3))
+        yield Move(grasp.carried().action(self.ik, look, closed=True), self.uniform(0.9, 1.3))
         yield Hold(np.inf)
 
     def holding(self, side: str, name: str) -> bool:

@@ -26,12 +26,13 @@ def test_grasp_and_lift(small_env, robot_name, name):
     body = model.body(name).id
     start_z = data.xpos[body][2]
 
-    grasp = plan_grasp(ik, side, YCB_OBJECTS[name], data.xpos[body].copy(), yaw, carry_m=(0.0, 0.0, LIFT_M))
+    grasp = plan_grasp(ik, side, YCB_OBJECTS[name], data.xpos[body].copy(), yaw, carry_m=(0.0, 0.0, LIFT_M),
+                       carry_tolerance_m=0.01)
     arm = canonical.LEFT if side == "left" else canonical.RIGHT
     rest = canonical.rest_action()
     hover = grasp.action(ik, rest, offset_m=0.08)
     hover[arm.position][2] += 0.12
-    closed, lifted = (g.action(ik, rest, closed=True) for g in (grasp, grasp.lifted(LIFT_M)))
+    closed, lifted = (g.action(ik, rest, closed=True) for g in (grasp, grasp.carried()))
     script = ActionScript(rest, [Keyframe(hover, 1.5), Keyframe(grasp.action(ik, rest, offset_m=0.08), 0.8),
                                  Keyframe(grasp.action(ik, rest), 0.8), Keyframe(closed, 0.8),
                                  Keyframe(lifted, 1.5)])
