@@ -220,13 +220,14 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
         pitch = float(pitches_rad[pitch_index])
         closing = Grasp(side, point, pitch, azimuth, flipped).closing_direction
         opening = min(gripper.stroke_m, width_across(prop, yaw_rad, closing) + PRESHAPE_MARGIN_M)
-        grasp = clear_the_palm(Grasp(side, point, pitch, azimuth, flipped, opening), gripper, top, center,
-                               prop.half_extent_xy(yaw_rad))
-        if grasp is None:
-            continue
+        nominal = Grasp(side, point, pitch, azimuth, flipped, opening)
+        grasp = clear_the_palm(nominal, gripper, top, center, prop.half_extent_xy(yaw_rad))
+        palm_hits = grasp is None
+        grasp = grasp or nominal
         path_gap, finger_gap = hand_clearance(grasp, obstacles, reach * np.cos(pitch),
                                               gripper.finger_thickness_m + gripper.pad_thickness_m)
-        blocked = path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M or finger_gap < CORRIDOR_MARGIN_M
+        blocked = (palm_hits or path_gap < gripper.palm_half_width_m + CORRIDOR_MARGIN_M
+                   or finger_gap < CORRIDOR_MARGIN_M)
         grasp_error = _reach_score(ik, grasp)
         if blocked or grasp_error > tolerance_m:
             score = grasp_error + 0.05 * blocked + 0.05
