@@ -121,6 +121,11 @@ class Controller:
         data.ctrl[self.world.neck_actuators] = 0.0
         self.set_command(canonical.rest_action())
 
+    def copy_setpoints(self, other: Controller) -> None:
+        """Take over another controller's command and gripper ramps (same world), e.g. to simulate ahead."""
+        self.set_command(other.command)
+        self._finger_setpoint = dict(other._finger_setpoint)
+
     def set_command(self, action: np.ndarray) -> np.ndarray:
         """Validate a canonical action, clip head and gripper values to their ranges, and make it the command.
 

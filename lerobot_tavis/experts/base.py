@@ -72,6 +72,20 @@ class WaitUntil:
 Segment = Move | Hold | WaitUntil
 
 
+def play(segments: list[Segment], start: np.ndarray) -> list[np.ndarray]:
+    """The actions (one per 1/20 s step) of a finite list of Move / Hold segments played from `start`."""
+    actions, command = [], np.asarray(start, dtype=float)
+    for segment in segments:
+        segment_start, t = command.copy(), DT_S
+        while True:
+            command = segment.action_at(segment_start, t)
+            actions.append(command.copy())
+            if segment.done(t):
+                break
+            t += DT_S
+    return actions
+
+
 class Expert(abc.ABC):
     """Plays `behaviour()`; call `reset()` after each env reset, then `act()` once per env step."""
 

@@ -8,6 +8,7 @@ robot's own kinematics (privileged information a human demonstrator also has: a 
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -181,27 +182,35 @@ def carry_options(grasp: Grasp, carry_m) -> list[Grasp]:
             for offset in (carry, nearer) for pitch in pitches]
 
 
-def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad: float,
-               carry_m=(0.0, 0.0, 0.2), pitches_rad=PITCHES_RAD, max_azimuth_rad: float = MAX_AZIMUTH_RAD,
-               toward_rad: float | None = None, obstacles=(), tolerance_m: float = 0.008,
-               carry_tolerance_m: float = CARRY_TOLERANCE_M) -> Grasp:
-    """The first grasp that (1) keeps the hand's path clear of `obstacles` ((xy, radius, top z) of the other
-    props), (2) whose grasp pose is kinematically reachable within `tolerance_m` and (3) whose carried pose
-    (grasp point + `carry_m`) is reachable within `carry_tolerance_m`, in order
-    of preference: upright hand; azimuth within 45° of `toward_rad` (default: from the shoulder to the object);
-    the given pitch order; azimuth nearest `toward_rad`. Without such a grasp, the best-scoring one. Azimuths
-    farther than `max_azimuth_rad` from `toward_rad` are considered only when there is no other."""
+def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad: float, **kwargs) -> Grasp:
+    """The most preferred grasp of `grasp_candidates` (see there)."""
+    return next(grasp_candidates(ik, side, prop, center, yaw_rad, **kwargs))
+
+
+def grasp_candidates(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad: float,
+                     carry_m=(0.0, 0.0, 0.2), pitches_rad=PITCHES_RAD, max_azimuth_rad: float = MAX_AZIMUTH_RAD,
+                     toward_rad: float | None = None, obstacles=(), tolerance_m: float = 0.008,
+                     carry_tolerance_m: float = CARRY_TOLERANCE_M) -> Iterator[Grasp]:
+    """Grasps that (1) keep the hand's path clear of `obstacles` ((xy, radius, top z) of the other props) and the
+    palm clear of the object, (2) whose grasp pose is kinematically reachable within `tolerance_m` and (3) whose
+    carried pose (grasp point + `carry_m`) is reachable within `carry_tolerance_m`, in order of preference:
+    upright hand; azimuth within 45° of `toward_rad` (default: from the shoulder to the object); the given pitch
+    order; azimuth nearest `toward_rad`. Then the others, best-scoring first. Azimuths farther than
+    `max_azimuth_rad` from `toward_rad` are considered only when there is no other."""
     if toward_rad is None:
         shoulder_y = 0.2 if side == "left" else -0.2
         toward_rad = float(np.arctan2(center[1] - shoulder_y, max(center[0], 0.05)))
     bottom, top = center[2] - prop.height_m / 2, center[2] + prop.height_m / 2
-    pad = ik.robot.gripper.pad_length_m
+    gripper = ik.robot.gripper
     point = center.copy()
     # pads on the upper part of the object (the palm then stays clear of its top), never touching the surface below
-    point[2] = max(top - pad / 2 + PAD_ABOVE_TOP_M, bottom + pad / 2 + FLOOR_CLEARANCE_M)
-    options = closing_azimuths(prop, yaw_rad, ik.robot.gripper.stroke_m, toward_rad)
+    point[2] = max(top - gripper.pad_length_m / 2 + PAD_ABOVE_TOP_M, bottom + gripper.pad_length_m / 2 + FLOOR_CLEARANCE_M)
+    options = closing_azimuths(prop, yaw_rad, gripper.stroke_m, toward_rad)
     azimuths = [a for a in options if abs(np.angle(np.exp(1j * (a - toward_rad)))) <= max_azimuth_rad] or options[:1]
-    gripper = ik.robot.gripper
+    if pitches_rad is PITCHES_RAD and min(width_across(prop, yaw_rad, Grasp(side, point, 0.0, a, False)
+                                                           .closing_direction) for a in azimuths) > \
+            gripper.stroke_m - 2 * TIGHT_CLEARANCE_M:
+        pitches_rad = STEEP_PITCHES_RAD  # little room beside the object: come down from above
     reach = gripper.grasp_depth_m + FOREARM_CLEARANCE_M
 
     def preference(candidate):
@@ -209,13 +218,9 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
         deviation = abs(np.angle(np.exp(1j * (azimuth - toward_rad))))
         return flipped, deviation > NATURAL_AZIMUTH_RAD, pitch_index, deviation
 
-    if pitches_rad is PITCHES_RAD and min(width_across(prop, yaw_rad, Grasp(side, point, 0.0, a, False)
-                                                           .closing_direction) for a in azimuths) > \
-            gripper.stroke_m - 2 * TIGHT_CLEARANCE_M:
-        pitches_rad = STEEP_PITCHES_RAD  # little room beside the object: come down from above
     candidates = sorted(((f, a, i) for f in (False, True) for a in azimuths for i in range(len(pitches_rad))),
                         key=preference)
-    best, best_score = None, np.inf
+    rejected: list[tuple[float, int, Grasp]] = []
     for flipped, azimuth, pitch_index in candidates:
         pitch = float(pitches_rad[pitch_index])
         closing = Grasp(side, point, pitch, azimuth, flipped).closing_direction
@@ -235,9 +240,9 @@ def plan_grasp(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, yaw_rad
             carry_error, grasp = min(((_reach_score(ik, option.carried()), option)
                                       for option in carry_options(grasp, carry_m)), key=lambda pair: pair[0])
             if carry_error < carry_tolerance_m:
-                return grasp
+                yield grasp
+                continue
             score = grasp_error + carry_error
-
-        if score < best_score:
-            best, best_score = grasp, score
-    return best
+        rejected.append((score, len(rejected), grasp))
+    for _, _, grasp in sorted(rejected, key=lambda item: item[:2]):
+        yield grasp

@@ -15,11 +15,13 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.control import ArmIK
 from lerobot_tavis.envs.objects import PROPS
-from lerobot_tavis.experts.base import Expert, Hold, Move, Segment
+from lerobot_tavis.experts.base import Expert, Hold, Move, Segment, play
 from lerobot_tavis.experts.gaze import GazeSolver
-from lerobot_tavis.experts.grasping import Grasp, plan_grasp
+from lerobot_tavis.experts.grasping import Grasp, carry_options, grasp_candidates
+from lerobot_tavis.experts.imagination import Imagination
 
 SLOTS = {"left": canonical.LEFT, "right": canonical.RIGHT}
+IMAGINED_ROLLOUTS = 12  # picks tried in imagination before settling for the best of them
 
 
 class SkilledExpert(Expert):
@@ -29,6 +31,7 @@ class SkilledExpert(Expert):
         if not hasattr(self, "ik"):
             self.ik = ArmIK(self.env.world.robot)
             self.gaze = GazeSolver(self.env.world)
+            self.imagination = Imagination(self.env.world)
         super().reset()
 
     # -- state --------------------------------------------------------------------------------------------
@@ -87,54 +90,98 @@ class SkilledExpert(Expert):
         yield Move(action, self.uniform(*duration_s))
         yield Hold(self.uniform(*dwell_s))
 
-    def plan(self, name: str, side: str, carry_m, **kwargs) -> Grasp:
-        """A grasp of prop `name` whose approach avoids the other props near it."""
+    def candidates(self, name: str, side: str, carry_m, **kwargs):
+        """Grasps of prop `name` (see `grasp_candidates`) whose approach avoids the other props near it."""
         center, yaw = self.body_pose(name)
         obstacles = [(pos[:2], PROPS[other].footprint_radius_m, pos[2] + PROPS[other].height_m / 2)
                      for other in self.env.task_object.props()
                      if other != name and abs((pos := self.body_pose(other)[0])[2] - center[2]) < 0.1]
-        return plan_grasp(self.ik, side, PROPS[name], center, yaw, carry_m=carry_m, obstacles=obstacles, **kwargs)
+        return grasp_candidates(self.ik, side, PROPS[name], center, yaw, carry_m=carry_m, obstacles=obstacles,
+                                **kwargs)
 
     def look_and_pick(self, name: str, carry_m=(0.0, 0.0, 0.24), side: str | None = None,
                       pre_rise_m: tuple[float, float] = (0.05, 0.08),
                       carry_path: list | None = None, attempts: int = 3, **plan_kwargs) -> Iterator[Segment]:
         """Saccade to the object and reach for it (the hand sets off with the saccade or just after the eyes
         land), grasp with a closing ramp at the end of the approach, carry it by `carry_m` (world, m; or through
-        the offsets of `carry_path`) and hold. `plan_kwargs` go to `plan_grasp`. A grasp that closes on nothing
-        is retried, re-planned from where the object now is, like a person having another go."""
-        center, _ = self.body_pose(name)
-        side = side or self.side_for(center)
-        slots = SLOTS[side]
-        for attempt in range(attempts):
-            center, _ = self.body_pose(name)
-            grasp = self.plan(name, side, (carry_path or [carry_m])[-1], **plan_kwargs)
-            head_s = self.saccade_s()
-            look = self.looking_at(center)
-            pre = grasp.action(self.ik, look, offset_m=self.uniform(0.08, 0.11))
-            pre[slots.position][2] += self.uniform(*pre_rise_m)
-            if self.rng.random() < 0.5:  # reach together with the saccade
-                yield Move(pre, self.uniform(0.6, 0.8), head_s=head_s)
-            else:  # a short fixation first
-                yield Move(look, head_s, head_s=head_s)
-                yield Hold(self.uniform(0.0, 0.15))
-                yield Move(pre, self.uniform(0.55, 0.75))
-            yield Hold(self.uniform(0.05, 0.15))  # the arm catches up with the pre-grasp pose
-            yield Move(grasp.action(self.ik, look), self.uniform(0.55, 0.75))
-            # close with a ramp once there (the command crosses 0 halfway), then let the fingers squeeze
-            yield Move(grasp.action(self.ik, look, closed=True), self.uniform(0.2, 0.35))
-            yield Hold(self.uniform(0.15, 0.3))
-            if self.holding(side, name):
-                break
-            yield Move(pre, self.uniform(0.5, 0.7))  # open and back off, then try again
-        for offset in (carry_path or [])[:-1]:
-            yield Move(grasp.moved(offset).action(self.ik, look, closed=True), self.uniform(0.9, 1.3))
-        yield Move(grasp.carried().action(self.ik, look, closed=True), self.uniform(0.9, 1.3))
+        the offsets of `carry_path`) and hold. `plan_kwargs` go to `grasp_candidates`; candidates are tried in
+        imagination first and the first that works is executed. A grasp that closes on nothing is retried,
+        re-planned from where the object now is, like a person having another go."""
+        side = side or self.side_for(self.body_pose(name)[0])
+        carry = np.asarray((carry_path or [carry_m])[-1], dtype=float)
+        for _ in range(attempts):
+            reach, hold = self._imagine_pick(name, side, carry, pre_rise_m, carry_path, plan_kwargs)
+            yield from reach
+            if self.holding(self.env.data, side, name):
+                yield from hold
+                return
+            yield Move(reach[-4].target, self.uniform(0.5, 0.7))  # open and back off to the pre-grasp, try again
         yield Hold(np.inf)
 
-    def holding(self, side: str, name: str) -> bool:
-        """Whether prop `name` is between the (not fully closed) fingers of `side`'s hand."""
+    def _imagine_pick(self, name, side, carry, pre_rise_m, carry_path, plan_kwargs) -> tuple[list, list]:
+        """Segments of the first pick that succeeds in imagination (grasp candidates in order of preference; for
+        a grasp that holds, its ways of carrying), else of the one that got the object nearest to success."""
+        best, best_progress, rollouts = None, -np.inf, 0
+        for grasp in self.candidates(name, side, carry, **plan_kwargs):
+            reach, hold = self._pick_segments(name, side, grasp, pre_rise_m, carry_path)
+            options = [hold] + [self._carry_segments(option, name, carry_path)
+                                for option in carry_options(grasp, grasp.carry_offset_m)[1:]]
+            for hold in options:
+                progress = self._imagined_progress(reach, hold, side, name, carry)
+                rollouts += 1
+                if progress >= 1.0:
+                    return reach, hold
+                if progress > best_progress:
+                    best, best_progress = (reach, hold), progress
+                if progress < 0 or rollouts >= IMAGINED_ROLLOUTS:
+                    break  # not even grasped: other ways of carrying will not help
+            if rollouts >= IMAGINED_ROLLOUTS:
+                break
+        return best
+
+    def _pick_segments(self, name, side, grasp: Grasp, pre_rise_m, carry_path) -> tuple[list, list]:
+        """The segments of one pick: reaching and closing, then carrying and holding."""
+        look = self.looking_at(self.body_pose(name)[0])
+        head_s = self.saccade_s()
+        pre = grasp.action(self.ik, look, offset_m=self.uniform(0.08, 0.11))
+        pre[SLOTS[side].position][2] += self.uniform(*pre_rise_m)
+        if self.rng.random() < 0.5:  # reach together with the saccade
+            reach = [Move(pre, self.uniform(0.6, 0.8), head_s=head_s)]
+        else:  # a short fixation first
+            reach = [Move(look, head_s, head_s=head_s), Hold(self.uniform(0.0, 0.15)),
+                     Move(pre, self.uniform(0.55, 0.75))]
+        reach += [
+            Move(pre, self.uniform(0.05, 0.15)),  # the arm catches up with the pre-grasp pose
+            Move(grasp.action(self.ik, look), self.uniform(0.55, 0.75)),
+            # close with a ramp once there (the command crosses 0 halfway), then let the fingers squeeze
+            Move(grasp.action(self.ik, look, closed=True), self.uniform(0.2, 0.35)),
+            Hold(self.uniform(0.15, 0.3)),
+        ]
+        return reach, self._carry_segments(grasp, name, carry_path)
+
+    def _carry_segments(self, grasp: Grasp, name: str, carry_path) -> list[Segment]:
+        look = self.looking_at(self.body_pose(name)[0])
+        hold = [Move(grasp.moved(offset).action(self.ik, look, closed=True), self.uniform(0.9, 1.3))
+                for offset in (carry_path or [])[:-1]]
+        hold.append(Move(grasp.carried().action(self.ik, look, closed=True), self.uniform(0.9, 1.3)))
+        return hold
+
+    def _imagined_progress(self, reach: list[Segment], hold: list[Segment], side: str, name: str,
+                           carry: np.ndarray) -> float:
+        """Play a pick in imagination: 1.0 if the task succeeds with the object in hand, else the fraction of the
+        carry the object followed; -1 if it was not grasped."""
+        body = self.env.model.body(name).id
+        start = self.env.data.xpos[body].copy()
+        data = self.imagination.rollout(self.env.data, self.env.controller, play(reach + hold, self.command))
+        if not self.holding(data, side, name):
+            return -1.0
+        if self.env.task_object.is_success(data):
+            return 1.0
+        return float(np.dot(data.xpos[body] - start, carry) / max(np.dot(carry, carry), 1e-9))
+
+    def holding(self, data, side: str, name: str) -> bool:
+        """Whether prop `name` is between the (not fully closed) fingers of `side`'s hand in `data`."""
         arm = self.env.world.arms[side]
-        data = self.env.data
         opening = data.qpos[arm.finger_qpos[0]]
-        near = np.linalg.norm(data.site_xpos[arm.grasp_site] - self.body_pose(name)[0]) < 0.05
+        near = np.linalg.norm(data.site_xpos[arm.grasp_site] - data.xpos[self.env.model.body(name).id]) < 0.05
         return bool(opening > 0.004 and near)
