@@ -225,7 +225,7 @@ def grasp_candidates(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, y
         pitch = float(pitches_rad[pitch_index])
         closing = Grasp(side, point, pitch, azimuth, flipped).closing_direction
         opening = min(gripper.stroke_m, width_across(prop, yaw_rad, closing) + PRESHAPE_MARGIN_M)
-        nominal = Grasp(side, point, pitch, azimuth, flipped, opening)
+        nominal = Grasp(side, point, pitch, azimuth, flipped, opening, tuple(np.asarray(carry_m, dtype=float)))
         grasp = clear_the_palm(nominal, gripper, top, center, prop.half_extent_xy(yaw_rad))
         palm_hits = grasp is None
         grasp = grasp or nominal

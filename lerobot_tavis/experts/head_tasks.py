@@ -73,5 +73,5 @@ class ShelfExpert(SkilledExpert):
         center, _ = self.body_pose(task.target)
         side = self.side_for(center)
         yield from self.look_and_pick(task.target, PULL_OUT, side=side, pre_rise_m=(0.0, 0.01),
-                                      pitches_rad=np.radians((10.0, 0.0, 20.0, 30.0)), max_azimuth_rad=0.5,
+                                      pitches_rad=np.radians((10.0, 0.0, 20.0, 30.0)), max_azimuth_rad=0.9,
                                       toward_rad=0.0)
