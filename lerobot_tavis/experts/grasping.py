@@ -32,6 +32,7 @@ CORRIDOR_MARGIN_M = 0.005
 PRESHAPE_MARGIN_M = 0.03  # open this much wider than the object
 FOREARM_CLEARANCE_M = 0.08
 CYLINDER_AZIMUTH_OFFSETS_RAD = (0.0, -0.35, 0.35, -0.7, 0.7)
+BOX_AZIMUTH_OFFSETS_RAD = (0.0, -0.2, 0.2)  # a slightly skewed grip still holds a box
 
 
 @dataclass(frozen=True)
@@ -102,7 +103,8 @@ def closing_azimuths(prop: PropSpec, yaw_rad: float, stroke_m: float, toward_rad
     """Approach azimuths (rad) whose closing direction spans a prop side that fits in the gripper.
 
     Cylinders are approached from around `toward_rad` (the arm's natural direction); a box from across either of its
-    horizontal axes (closing along the other), from whichever side faces `toward_rad`. Sorted by closeness to
+    horizontal axes (closing along the other, give or take 0.2 rad), from whichever side faces `toward_rad`.
+    Sorted by closeness to
     `toward_rad`, wrapped to [-pi, pi].
     """
     if prop.shape == "cylinder":
@@ -114,7 +116,7 @@ def closing_azimuths(prop: PropSpec, yaw_rad: float, stroke_m: float, toward_rad
         approach = yaw_rad + closing_axis * np.pi / 2 + np.pi / 2  # perpendicular to the closing direction
         if np.cos(approach - toward_rad) < 0:
             approach += np.pi  # the side facing the hand
-        options.append(float(np.angle(np.exp(1j * approach))))
+        options += [float(np.angle(np.exp(1j * (approach + offset)))) for offset in BOX_AZIMUTH_OFFSETS_RAD]
     return sorted(options, key=lambda a: abs(np.angle(np.exp(1j * (a - toward_rad)))))
 
 
