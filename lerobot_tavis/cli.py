@@ -7,9 +7,11 @@ import sys
 
 
 def _demo(args: argparse.Namespace) -> None:
-    from lerobot_tavis.demo import run_demo
+    from lerobot_tavis.demo import TASKS, run_demo
 
-    for path in run_demo(args.out, robots=args.robots, image_size=_image_size(args.image_size), seed=args.seed):
+    tasks = args.tasks or TASKS
+    for path in run_demo(args.out, robots=args.robots, tasks=tasks, image_size=_image_size(args.image_size),
+                         seed=args.seed):
         print(path)
 
 
@@ -24,10 +26,11 @@ def _image_size(text: str) -> tuple[int, int]:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tavis", description="TAVIS active-vision benchmark in MuJoCo")
     commands = parser.add_subparsers(dest="command", required=True)
-    demo = commands.add_parser("demo", help="scripted look-and-reach on both robots: MP4 per camera + PNG sheet")
+    demo = commands.add_parser("demo", help="one demonstrator episode per task and robot: MP4 of the four views")
     demo.add_argument("--out", default="outputs/demo", help="output directory (default: outputs/demo)")
     demo.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"], choices=["gr1t2", "reachy2"])
-    demo.add_argument("--image-size", default="480x640", help="HxW of every camera (default 480x640)")
+    demo.add_argument("--tasks", nargs="+", help="task names (default: the eight TAVIS tasks)")
+    demo.add_argument("--image-size", default="240x320", help="HxW of every camera (default 240x320)")
     demo.add_argument("--seed", type=int, default=0)
     demo.set_defaults(run=_demo)
     return parser

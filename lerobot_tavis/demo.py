@@ -1,7 +1,7 @@
-"""`tavis demo`: a scripted look-and-reach on each robot, filmed by all four cameras.
+"""`tavis demo`: one scripted-demonstrator episode of every task on each robot, filmed by all four cameras.
 
-The head turns to centre an object, holds the fixation, then the arm on the object's side reaches, grasps and
-lifts it. Writes one MP4 per camera per robot and a PNG sheet of the four views at the moment of the grasp.
+Writes `<out>/<robot>/<task>.mp4` with the head, fixed and wrist views side by side (the head view is black in
+blocked_clutter_pick_cube, as the policy sees it) and prints whether each episode succeeded.
 """
 
 from __future__ import annotations
@@ -11,69 +11,45 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from lerobot_tavis import canonical
 from lerobot_tavis.envs.env import TavisEnv
-from lerobot_tavis.envs.objects import OBJECT_NAMES, YCB_OBJECTS
 from lerobot_tavis.envs.rendering import CameraRig
-from lerobot_tavis.experts.gaze import GazeSolver
-from lerobot_tavis.experts.grasping import plan_grasp
-from lerobot_tavis.experts.motion import ActionScript, Keyframe
-from lerobot_tavis.media import sheet, write_mp4, write_png
+from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
+from lerobot_tavis.envs.world import CAMERA_NAMES
+from lerobot_tavis.experts.registry import make_expert
+from lerobot_tavis.media import side_by_side, write_mp4
 
 FPS = 20
+TASKS = tuple(task for suite in SUITES for task in suite_tasks(suite))
 
 
-def look_and_reach_script(env: TavisEnv, target: str) -> tuple[ActionScript, float]:
-    """The keyframes of the demo and the time (s) at which the gripper has closed."""
-    model, data, world = env.model, env.data, env.world
-    centre = data.xpos[model.body(target).id].copy()
-    yaw = float(np.arctan2(*data.xmat[model.body(target).id].reshape(3, 3)[[1, 0], 0]))
-    side = "left" if centre[1] >= 0 else "right"
-    ik = env.controller.ik
-    grasp = plan_grasp(ik, side, YCB_OBJECTS[target], centre, yaw)
-    pitch, head_yaw = GazeSolver(world).angles_to(centre)
-    look = canonical.rest_action()
-    look[canonical.HEAD_PITCH], look[canonical.HEAD_YAW] = pitch, head_yaw
-    pre = grasp.action(ik, look, offset_m=0.08)
-    hover = pre.copy()
-    hover[(canonical.LEFT if side == "left" else canonical.RIGHT).position][2] += 0.12
-    keyframes = [
-        Keyframe(canonical.rest_action(), 0.5),  # a look at the scene
-        Keyframe(look, 0.25),  # saccade to the object
-        Keyframe(look, 0.6),  # fixation
-        Keyframe(hover, 1.5),
-        Keyframe(pre, 0.8),
-        Keyframe(grasp.action(ik, look), 0.8),
-        Keyframe(grasp.action(ik, look, closed=True), 0.8),
-        Keyframe(grasp.carried().action(ik, look, closed=True), 1.5),
-        Keyframe(grasp.carried().action(ik, look, closed=True), 0.7),
-    ]
-    closed_at = sum(k.duration_s for k in keyframes[:7])
-    return ActionScript(canonical.rest_action(), keyframes), closed_at
+def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) -> tuple[list[np.ndarray], bool]:
+    """Frames (four labelled views side by side) of one demonstrator episode, and whether it succeeded."""
+    env = TavisEnv(task, robot, camera_mode="head_wrist", image_size=image_size)
+    env.reset(seed=seed)
+    rig = CameraRig(env.model, {name: env.world.cameras[name] for name in CAMERA_NAMES}, image_size,
+                    blacked_out=env.task_object.blacked_out_cameras)
+    expert = make_expert(env, seed)
+    expert.reset()
+    frames, success = [side_by_side(rig.render(env.data))], False
+    for _ in range(env._max_episode_steps):
+        _, _, terminated, truncated, info = env.step(expert.act())
+        frames.append(side_by_side(rig.render(env.data)))
+        success = info["is_success"]
+        if terminated or truncated:
+            break
+    frames += frames[-1:] * FPS  # one more second on the final frame
+    rig.close()
+    env.close()
+    return frames, success
 
 
-def run_demo(out_dir: str | Path, robots=("gr1t2", "reachy2"), image_size=(480, 640), seed: int = 0) -> list[Path]:
+def run_demo(out_dir: str | Path, robots=("gr1t2", "reachy2"), tasks=TASKS, image_size=(240, 320),
+             seed: int = 0) -> list[Path]:
     out_dir = Path(out_dir)
     written = []
     for robot in robots:
-        env = TavisEnv("tabletop", robot, camera_mode="headcam", image_size=image_size)
-        env.reset(seed=seed)
-        rig = CameraRig(env.model, env.world.cameras, image_size)
-        target = OBJECT_NAMES[int(np.random.default_rng(seed).integers(len(OBJECT_NAMES)))]
-        script, closed_at = look_and_reach_script(env, target)
-        frames: dict[str, list[np.ndarray]] = {name: [] for name in env.world.cameras}
-        grasp_views = None
-        steps = int(np.ceil(script.duration_s * FPS))
-        for step in tqdm(range(steps), desc=f"demo {robot}: look at and lift the {target}", unit="step"):
-            env.step(script.action_at((step + 1) / FPS))
-            views = rig.render(env.data)
-            for name, image in views.items():
-                frames[name].append(image)
-            if grasp_views is None and (step + 1) / FPS >= closed_at:
-                grasp_views = views
-        rig.close()
-        env.close()
-        for name, images in frames.items():
-            written.append(write_mp4(out_dir / robot / f"{name}.mp4", images, FPS))
-        written.append(write_png(out_dir / robot / "cameras.png", sheet(grasp_views)))
+        for task in tqdm(tasks, desc=f"demo {robot}", unit="task"):
+            frames, success = film_episode(task, robot, image_size, seed)
+            written.append(write_mp4(out_dir / robot / f"{task}.mp4", frames, FPS))
+            tqdm.write(f"{robot} {task}: {'success' if success else 'failure'} in {len(frames) - 1 - FPS} steps")
     return written
