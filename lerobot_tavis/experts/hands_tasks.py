@@ -33,8 +33,9 @@ class PeekingBoxExpert(SkilledExpert):
         for opening in self.rng.permutation(["+y", "-y"]):
             sign = 1.0 if opening == "+y" else -1.0
             side = SIDE_OF[opening]
-            outside = box_point(self.uniform(-0.05, 0.0), sign * (peeking_box.HALF_WIDTH + 0.18), 1.16)
-            inside = box_point(self.uniform(-0.02, 0.04), 0.0, TABLE_TOP_Z + 0.06)
+            # far enough out that the fingertips stay outside the box while the wrist camera looks in
+            outside = box_point(self.uniform(-0.05, 0.0), sign * (peeking_box.HALF_WIDTH + 0.24), 1.12)
+            inside = box_point(self.uniform(-0.02, 0.04), 0.0, TABLE_TOP_Z + 0.05)
             yield from self.fixate(outside, (0.1, 0.2))
             yield from self.peek(side, outside, inside)
             if opening == task.open_side:
