@@ -1,4 +1,4 @@
-"""Videos and image sheets of camera frames. Files are written to a temporary name and renamed when complete."""
+"""Videos of camera frames. Files are written to a temporary name and renamed when complete."""
 
 from __future__ import annotations
 
@@ -41,22 +41,3 @@ def label(image: np.ndarray, text: str) -> np.ndarray:
 def side_by_side(frames: dict[str, np.ndarray]) -> np.ndarray:
     """Labelled frames of equal height in one row."""
     return np.concatenate([label(image, name) for name, image in frames.items()], axis=1)
-
-
-def sheet(frames: dict[str, np.ndarray], columns: int = 2) -> np.ndarray:
-    """Labelled frames of equal size on a grid, row by row."""
-    images = [label(image, name) for name, image in frames.items()]
-    blank = np.zeros_like(images[0])
-    images += [blank] * (-len(images) % columns)
-    rows = [np.concatenate(images[i:i + columns], axis=1) for i in range(0, len(images), columns)]
-    return np.concatenate(rows, axis=0)
-
-
-def write_png(path: str | Path, image: np.ndarray) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f".{path.name}.partial.png")
-    if not cv2.imwrite(str(partial), image[..., ::-1]):
-        raise OSError(f"could not write {path}")
-    os.replace(partial, path)
-    return path

@@ -67,9 +67,6 @@ class Grasp:
         """The same hand orientation with the grasp point shifted by `offset_m` (world, m): carrying."""
         return replace(self, point=self.point + np.asarray(offset_m, dtype=float))
 
-    def lifted(self, height_m: float) -> Grasp:
-        return self.moved((0.0, 0.0, height_m))
-
     def carried(self) -> Grasp:
         """The hand pose holding the object at its carry position (the carry offset and pitch chosen by the
         planner)."""
@@ -206,7 +203,8 @@ def grasp_candidates(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, y
     gripper = ik.robot.gripper
     point = center.copy()
     # pads on the upper part of the object (the palm then stays clear of its top), never touching the surface below
-    point[2] = max(top - gripper.pad_length_m / 2 + PAD_ABOVE_TOP_M, bottom + gripper.pad_length_m / 2 + FLOOR_CLEARANCE_M)
+    point[2] = max(top - gripper.pad_length_m / 2 + PAD_ABOVE_TOP_M,
+                   bottom + gripper.pad_length_m / 2 + FLOOR_CLEARANCE_M)
     options = closing_azimuths(prop, yaw_rad, gripper.stroke_m, toward_rad)
     azimuths = [a for a in options if abs(np.angle(np.exp(1j * (a - toward_rad)))) <= max_azimuth_rad] or options[:1]
     if pitches_rad is PITCHES_RAD and min(width_across(prop, yaw_rad, Grasp(side, point, 0.0, a, False)

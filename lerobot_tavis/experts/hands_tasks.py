@@ -6,7 +6,6 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from lerobot_tavis import canonical
 from lerobot_tavis.envs.scene import TABLE_TOP_Z
 from lerobot_tavis.envs.tasks import occluded_reach, peeking_box
 from lerobot_tavis.envs.transforms import axis_angle_quat, matrix_from_quat

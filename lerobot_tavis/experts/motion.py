@@ -1,12 +1,10 @@
-"""Human-like motion primitives for scripted actions: minimum-jerk profiles and keyframed 19-D action scripts.
+"""Human-like motion primitives for scripted actions: minimum-jerk profiles and interpolation of 19-D actions.
 
 Everything here works on canonical actions (numpy only, no simulator): positions in the canonical frame (m),
 quaternions w, x, y, z, head angles (rad), grippers in [-1, 1].
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -32,14 +30,6 @@ def slerp(q0, q1, s: float) -> np.ndarray:
     return (np.sin((1 - s) * theta) * q0 + np.sin(s * theta) * q1) / np.sin(theta)
 
 
-def top_down_hand_quat(yaw_rad: float) -> np.ndarray:
-    """Hand orientation pointing the gripper straight down, turned `yaw_rad` about the world z axis.
-
-    At yaw 0 the fingers close along the world y axis (hand-frame convention of `envs.robots.parts`).
-    """
-    return np.array([np.cos(yaw_rad / 2), 0.0, 0.0, np.sin(yaw_rad / 2)])
-
-
 def interpolate_action(start: np.ndarray, end: np.ndarray, s: float) -> np.ndarray:
     """Action at progress s in [0, 1] between two actions: linear in position, head and grippers, slerp in
     orientation (apply a profile such as `min_jerk` to s first)."""
@@ -47,32 +37,3 @@ def interpolate_action(start: np.ndarray, end: np.ndarray, s: float) -> np.ndarr
     for arm in canonical.ARMS:
         action[arm.quaternion] = slerp(start[arm.quaternion], end[arm.quaternion], s)
     return action
-
-
-@dataclass(frozen=True)
-class Keyframe:
-    """Move to `action` over `duration_s` with a minimum-jerk profile, then continue with the next keyframe."""
-
-    action: np.ndarray
-    duration_s: float
-
-
-class ActionScript:
-    """A sequence of keyframes played from a start action; `action_at(t)` gives the commanded action at t (s)."""
-
-    def __init__(self, start: np.ndarray, keyframes: list[Keyframe]):
-        self.start = np.asarray(start, dtype=float)
-        self.keyframes = keyframes
-        self.ends = np.cumsum([k.duration_s for k in keyframes])
-
-    @property
-    def duration_s(self) -> float:
-        return float(self.ends[-1]) if len(self.ends) else 0.0
-
-    def action_at(self, t: float) -> np.ndarray:
-        previous, t0 = self.start, 0.0
-        for keyframe, t1 in zip(self.keyframes, self.ends):
-            if t < t1:
-                return interpolate_action(previous, keyframe.action, float(min_jerk((t - t0) / keyframe.duration_s)))
-            previous, t0 = keyframe.action, t1
-        return previous.copy()

@@ -8,7 +8,7 @@ from lerobot_tavis import canonical
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES, YCB_OBJECTS
 from lerobot_tavis.experts.grasping import plan_grasp
-from lerobot_tavis.experts.motion import ActionScript, Keyframe
+from lerobot_tavis.experts.base import Move, play
 
 LIFT_M = 0.20
 
@@ -33,11 +33,10 @@ def test_grasp_and_lift(small_env, robot_name, name):
     hover = grasp.action(ik, rest, offset_m=0.08)
     hover[arm.position][2] += 0.12
     closed, lifted = (g.action(ik, rest, closed=True) for g in (grasp, grasp.carried()))
-    script = ActionScript(rest, [Keyframe(hover, 1.5), Keyframe(grasp.action(ik, rest, offset_m=0.08), 0.8),
-                                 Keyframe(grasp.action(ik, rest), 0.8), Keyframe(closed, 0.8),
-                                 Keyframe(lifted, 1.5)])
-    for step in range(int(script.duration_s * 20)):
-        env.step(script.action_at((step + 1) / 20))
+    segments = [Move(hover, 1.5), Move(grasp.action(ik, rest, offset_m=0.08), 0.8), Move(grasp.action(ik, rest), 0.8),
+                Move(closed, 0.8), Move(lifted, 1.5)]
+    for action in play(segments, rest):
+        env.step(action)
     site = env.world.arms[side].grasp_site
     offset_before_hold = data.xpos[body] - data.site_xpos[site]
     for _ in range(20):  # hold for 1 s

@@ -70,8 +70,10 @@ class MultiShelfScan(YcbTask):
             yaw = rng.uniform(-np.pi, np.pi)
             hx, hy = PROPS[name].half_extent_xy(yaw)
             # the reference's clamps, tightened so an object never sticks into the back panel or a side wall
-            x = np.clip(SHELF_X + jitter[0], max(SLOT_X_CLAMP[0], INNER_X[0] + hx), min(SLOT_X_CLAMP[1], INNER_X[1] - hx))
-            y = np.clip(slot_y + jitter[1], max(SLOT_Y_CLAMP[0], INNER_Y[0] + hy), min(SLOT_Y_CLAMP[1], INNER_Y[1] - hy))
+            x = np.clip(SHELF_X + jitter[0], max(SLOT_X_CLAMP[0], INNER_X[0] + hx),
+                        min(SLOT_X_CLAMP[1], INNER_X[1] - hx))
+            y = np.clip(slot_y + jitter[1], max(SLOT_Y_CLAMP[0], INNER_Y[0] + hy),
+                        min(SLOT_Y_CLAMP[1], INNER_Y[1] - hy))
             surface = BOARD_Z[shelf] + BOARD_THICKNESS / 2
             placement.set_free_pose(model, data, name, (x, y, placement.standing_z(name, surface)), yaw)
 
