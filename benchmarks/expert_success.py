@@ -1,10 +1,12 @@
-"""Success rate of the scripted demonstrators per task x robot x split.
+"""Success rate and gaze lead (GALT) of the scripted demonstrators per task x robot x split.
 
     python benchmarks/expert_success.py [--episodes 96] [--robots gr1t2 reachy2] [--splits id ood_spatial]
                                         [--tasks ...] [--workers 2]
 
 Seeds 0..episodes-1 per cell; each cell runs in its own process (tiny 16x16 images: the demonstrators read the
-simulator state, not pixels). Prints a Markdown table with Wilson 95% intervals and the wall-clock time.
+simulator state, not pixels). Prints a Markdown table with Wilson 95% intervals and, for TAVIS-Head tasks, GALT over
+the successful episodes (computed from the applied actions at 20 Hz, as the reference does): the share with a
+positive lead and the median lead in seconds.
 """
 
 from __future__ import annotations
@@ -15,17 +17,22 @@ import os
 import time
 
 
-def run_cell(args: tuple[str, str, str, int]) -> tuple[str, str, str, int, int, float]:
+def run_cell(args: tuple[str, str, str, int]) -> tuple[str, str, str, int, int, list]:
     task, robot, split, episodes = args
     os.environ.setdefault("MUJOCO_GL", "egl")
     from lerobot_tavis.envs.env import TavisEnv
     from lerobot_tavis.experts.registry import run_episode
+    from lerobot_tavis.metrics.galt import compute_galt
 
     env = TavisEnv(task, robot, camera_mode="headcam", split=split, image_size=(16, 16))
-    start = time.perf_counter()
-    successes = sum(run_episode(env, seed).success for seed in range(episodes))
+    successes, leads = 0, []
+    for seed in range(episodes):
+        result = run_episode(env, seed)
+        if result.success:
+            successes += 1
+            leads.append(compute_galt(result.actions, fps=20).galt_s)
     env.close()
-    return task, robot, split, successes, episodes, time.perf_counter() - start
+    return task, robot, split, successes, episodes, leads
 
 
 def main() -> None:
@@ -42,19 +49,32 @@ def main() -> None:
     cells = [(t, r, s, args.episodes) for r in args.robots for t in args.tasks for s in args.splits]
     start = time.perf_counter()
     with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
-        results = {(t, r, s): (k, n, dt) for t, r, s, k, n, dt in pool.imap_unordered(run_cell, cells)}
+        results = {(t, r, s): (k, n, leads) for t, r, s, k, n, leads in pool.imap_unordered(run_cell, cells)}
     print(f"{args.episodes} episodes per cell, seeds 0..{args.episodes - 1}; "
           f"{time.perf_counter() - start:.0f} s wall on {args.workers} workers\n")
-    print("| task | robot | " + " | ".join(args.splits) + " |")
-    print("|---|---|" + "---|" * len(args.splits))
+    print("| task | robot | " + " | ".join(f"{s} success | {s} GALT > 0, median" for s in args.splits) + " |")
+    print("|---|---|" + "---|---|" * len(args.splits))
     for robot in args.robots:
         for task in args.tasks:
             cells_text = []
             for split in args.splits:
-                k, n, _ = results[(task, robot, split)]
+                k, n, leads = results[(task, robot, split)]
                 low, high = wilson_interval(k, n)
                 cells_text.append(f"{100 * k / n:.1f}% [{100 * low:.1f}, {100 * high:.1f}] ({k}/{n})")
+                cells_text.append(_lead_text(leads) if task in suite_tasks("tavis_head") else "")
             print(f"| {task} | {robot} | " + " | ".join(cells_text) + " |")
+
+
+def _lead_text(leads: list) -> str:
+    """Share of successful episodes with a valid, positive lead, and the median valid lead (s)."""
+    import numpy as np
+
+    valid = [lead for lead in leads if lead is not None]
+    if not leads:
+        return "-"
+    positive = sum(lead > 0 for lead in valid)
+    median = f"{np.median(valid):.2f} s" if valid else "-"
+    return f"{100 * positive / len(leads):.0f}% ({positive}/{len(leads)}), {median}"
 
 
 if __name__ == "__main__":
