@@ -4,7 +4,8 @@ An expert's `behaviour()` yields segments one at a time; each starts from the ac
 a behaviour can look at the (privileged) simulator state between segments to decide what to do next. Segments:
 
 - `Move`: arms, grippers and head to a target action; the arms follow a minimum-jerk profile over `duration_s`,
-  the head a fast minimum-jerk saccade over `head_s` then holds still, the grippers ramp linearly.
+  the head a fast minimum-jerk saccade over `head_s` (starting `head_delay_s` into the move) then holds still, the
+  grippers ramp linearly.
 - `Hold`: keep the current command for `duration_s`.
 - `WaitUntil`: keep the current command until `condition()` is true (or `timeout_s` passes).
 
@@ -31,11 +32,12 @@ class Move:
     target: np.ndarray
     duration_s: float
     head_s: float | None = None  # default: the head moves with the arms
+    head_delay_s: float = 0.0  # the head starts its move this late (a saccade launched during a reach)
 
     def action_at(self, start: np.ndarray, t: float) -> np.ndarray:
         action = interpolate_action(start, self.target, float(min_jerk(t / self.duration_s)))
         head_s = self.head_s or self.duration_s
-        s_head = float(min_jerk(t / head_s))
+        s_head = float(min_jerk((t - self.head_delay_s) / head_s))
         action[canonical.HEAD] = start[canonical.HEAD] + s_head * (self.target[canonical.HEAD] - start[canonical.HEAD])
         s_grip = min(t / self.duration_s, 1.0)
         for arm in canonical.ARMS:
@@ -43,7 +45,7 @@ class Move:
         return action
 
     def done(self, t: float) -> bool:
-        return t >= max(self.duration_s, self.head_s or 0.0) - 1e-9
+        return t >= max(self.duration_s, self.head_delay_s + (self.head_s or 0.0)) - 1e-9
 
 
 @dataclass(frozen=True)

@@ -102,9 +102,9 @@ class SkilledExpert(Expert):
     def look_and_pick(self, name: str, carry_m=(0.0, 0.0, 0.24), side: str | None = None,
                       pre_rise_m: tuple[float, float] = (0.05, 0.08),
                       carry_path: list | None = None, attempts: int = 3, **plan_kwargs) -> Iterator[Segment]:
-        """Saccade to the object and reach for it (the hand sets off with the saccade or just after the eyes
-        land), grasp with a closing ramp at the end of the approach, carry it by `carry_m` (world, m; or through
-        the offsets of `carry_path`) and hold. `plan_kwargs` go to `grasp_candidates`; candidates are tried in
+        """Saccade to the object and reach for it (the eyes land during the reach or just before it), grasp
+        with a closing ramp at the end of the approach, carry it by `carry_m` (world, m; or through the offsets of
+        `carry_path`) and hold. `plan_kwargs` go to `grasp_candidates`; candidates are tried in
         imagination first and the first that works is executed. A grasp that closes on nothing is retried,
         re-planned from where the object now is, like a person having another go."""
         side = side or self.side_for(self.body_pose(name)[0])
@@ -145,14 +145,14 @@ class SkilledExpert(Expert):
         head_s = self.saccade_s()
         pre = grasp.action(self.ik, look, offset_m=self.uniform(0.08, 0.11))
         pre[SLOTS[side].position][2] += self.uniform(*pre_rise_m)
-        if self.rng.random() < 0.5:  # reach together with the saccade
-            reach = [Move(pre, self.uniform(0.6, 0.8), head_s=head_s)]
-        else:  # a short fixation first
-            reach = [Move(look, head_s, head_s=head_s), Hold(self.uniform(0.0, 0.15)),
-                     Move(pre, self.uniform(0.55, 0.75))]
+        if self.rng.random() < 0.5:  # the hand sets off first; the eyes jump to the object during the reach
+            reach = [Move(pre, self.uniform(0.6, 0.8), head_s=head_s, head_delay_s=self.uniform(0.3, 0.55))]
+        else:  # the eyes land first, a short fixation, then the reach
+            reach = [Move(look, head_s, head_s=head_s), Hold(self.uniform(0.0, 0.1)),
+                     Move(pre, self.uniform(0.4, 0.55))]
         reach += [
-            Move(pre, self.uniform(0.05, 0.15)),  # the arm catches up with the pre-grasp pose
-            Move(grasp.action(self.ik, look), self.uniform(0.55, 0.75)),
+            Move(pre, self.uniform(0.05, 0.1)),  # the arm catches up with the pre-grasp pose
+            Move(grasp.action(self.ik, look), self.uniform(0.45, 0.6)),
             # close with a ramp once there (the command crosses 0 halfway), then let the fingers squeeze
             Move(grasp.action(self.ik, look, closed=True), self.uniform(0.2, 0.35)),
             Hold(self.uniform(0.15, 0.3)),
