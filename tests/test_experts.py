@@ -1,0 +1,67 @@
+"""The scripted demonstrators: they finish their tasks, look first, and are reproducible."""
+
+import numpy as np
+import pytest
+
+from lerobot_tavis.envs.env import TavisEnv
+from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
+from lerobot_tavis.experts.base import Hold, Move, play
+from lerobot_tavis.experts.registry import make_expert, run_episode
+from lerobot_tavis.metrics.galt import compute_galt
+
+TASKS = [task for suite in SUITES for task in suite_tasks(suite)]
+
+
+@pytest.fixture
+def tiny_env():
+    envs = []
+
+    def make(task, robot="gr1t2", **kwargs):
+        env = TavisEnv(task, robot, camera_mode="headcam", image_size=(16, 16), **kwargs)
+        envs.append(env)
+        return env
+
+    yield make
+    for env in envs:
+        env.close()
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_demonstrator_completes_its_task(tiny_env, task):
+    env = tiny_env(task)
+    results = [run_episode(env, seed) for seed in range(3)]
+    assert any(r.success for r in results), f"{task}: no success in 3 seeds"
+    for result in results:
+        assert result.actions.shape == (result.length_steps, 19) and np.isfinite(result.actions).all()
+
+
+@pytest.mark.parametrize("task", ["conditional_pick", "clutter_pick_lift"])
+def test_gaze_arrives_before_the_grasp(tiny_env, task):
+    env = tiny_env(task, robot="reachy2")
+    leads = [compute_galt(r.actions, fps=20).galt_s for r in (run_episode(env, seed) for seed in range(3))
+             if r.success]
+    assert leads and all(lead is not None and 0.3 <= lead <= 2.0 for lead in leads), leads
+
+
+def test_same_seed_same_demonstration(tiny_env):
+    env = tiny_env("wait_then_act")
+    first, second = run_episode(env, 4), run_episode(env, 4)
+    np.testing.assert_array_equal(first.actions, second.actions)
+    other = run_episode(env, 5)
+    assert first.actions.shape != other.actions.shape or not np.array_equal(first.actions, other.actions)
+
+
+def test_unknown_task_has_no_demonstrator(tiny_env):
+    with pytest.raises(ValueError, match="no demonstrator for task 'tabletop'"):
+        make_expert(tiny_env("tabletop"), 0)
+
+
+def test_saccade_is_fast_then_still():
+    start = np.zeros(19)
+    target = start.copy()
+    target[15] = 0.6
+    actions = np.array(play([Move(target, 1.0, head_s=0.2, head_delay_s=0.3), Hold(0.3)], start))
+    pitch = actions[:, 15]
+    assert pitch[5] == 0.0  # still waiting for the saccade (t = 0.3 s)
+    assert pitch[10] == pytest.approx(0.6)  # landed by 0.5 s, while the 1 s arm move goes on
+    assert len(actions) == 26
