@@ -46,7 +46,7 @@ class PeekingBoxExpert(SkilledExpert):
         out = np.array([*(rotation[:2, :2] @ (0.0, sign * 0.22)), 0.0])  # back out through the opening
         yield from self.look_and_pick(task.target, side=side, pre_rise_m=(0.0, 0.01),
                                       carry_path=[out, out + HIGH_LIFT], toward_rad=float(into_box),
-                                      max_azimuth_rad=0.6, pitches_rad=np.radians((15.0, 25.0, 5.0, 35.0)))
+                                      max_azimuth_rad=0.9, pitches_rad=np.radians((15.0, 25.0, 5.0, 35.0)))
 
 
 class OccludedReachExpert(SkilledExpert):
