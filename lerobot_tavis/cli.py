@@ -15,6 +15,28 @@ def _demo(args: argparse.Namespace) -> None:
         print(path)
 
 
+def _eval(args: argparse.Namespace) -> None:
+    from pathlib import Path
+
+    from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
+
+    if bool(args.policy) == bool(args.expert):
+        raise ValueError("give exactly one of --policy PATH and --expert")
+    cfg = ProtocolConfig(out_dir=Path(args.out), robot=args.robot, suites=tuple(args.suite), splits=tuple(args.splits),
+                         n_episodes=args.episodes, camera_mode=args.camera_mode,
+                         image_size=_image_size(args.image_size), policy_path=args.policy,
+                         batch_size=args.batch_size, device=args.device, workers=args.workers, seed=args.seed)
+    for path in run_protocol(cfg):
+        print(path)
+
+
+def _report(args: argparse.Namespace) -> None:
+    from lerobot_tavis.eval.report import write_report
+
+    for path in write_report(args.eval_dir):
+        print(path)
+
+
 def _image_size(text: str) -> tuple[int, int]:
     try:
         height, width = (int(v) for v in text.lower().split("x"))
@@ -33,6 +55,28 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--image-size", default="240x320", help="HxW of every camera (default 240x320)")
     demo.add_argument("--seed", type=int, default=0)
     demo.set_defaults(run=_demo)
+
+    evaluate = commands.add_parser("eval", help="the 96-episode protocol for a policy checkpoint or the demonstrators")
+    evaluate.add_argument("--policy", help="policy checkpoint directory (pretrained_model)")
+    evaluate.add_argument("--expert", action="store_true", help="evaluate the scripted demonstrators instead")
+    evaluate.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
+    evaluate.add_argument("--suite", nargs="+", default=["tavis_head"], choices=["tavis_head", "tavis_hands"])
+    evaluate.add_argument("--splits", nargs="+", default=["id", "ood_spatial", "ood_init_pose"],
+                          choices=["id", "ood_spatial", "ood_init_pose"])
+    evaluate.add_argument("--episodes", type=int, default=96, help="episodes per task and split (default 96)")
+    evaluate.add_argument("--camera-mode", default="headcam",
+                          choices=["headcam", "fixedcam", "head_wrist", "fixed_wrist"])
+    evaluate.add_argument("--image-size", default="480x640")
+    evaluate.add_argument("--batch-size", type=int, default=1, help="parallel envs per task (policy runs)")
+    evaluate.add_argument("--device", default="cpu")
+    evaluate.add_argument("--workers", type=int, default=1, help="parallel processes (demonstrator runs)")
+    evaluate.add_argument("--seed", type=int, default=1000, help="first episode seed (lerobot-eval's default)")
+    evaluate.add_argument("--out", required=True, help="output directory; finished cells are skipped on re-runs")
+    evaluate.set_defaults(run=_eval)
+
+    report = commands.add_parser("report", help="success rates with Wilson CIs, GALT, plots from eval outputs")
+    report.add_argument("eval_dir", help="directory holding lerobot-eval outputs (eval_info.json, episodes.jsonl)")
+    report.set_defaults(run=_report)
     return parser
 
 

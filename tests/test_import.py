@@ -1,9 +1,14 @@
-"""LeRobot imports the plugin in every CLI, robot and teleop ones included: the top-level import must stay light."""
+"""LeRobot imports the plugin in every CLI, robot and teleop ones included: the top-level import must stay light.
+
+Registering the env type needs `lerobot.envs.configs` (which LeRobot's CLIs load anyway); beyond that, importing
+the plugin must not load the simulator, the demonstrators or any policy, dataset or video code.
+"""
 
 import subprocess
 import sys
 
-HEAVY = ("mujoco", "mink", "lerobot.policies", "lerobot.datasets", "transformers", "diffusers", "cv2", "av")
+HEAVY = ("mujoco", "mink", "lerobot.policies", "lerobot.datasets", "cv2", "av", "lerobot_tavis.envs.env",
+         "lerobot_tavis.experts", "lerobot_tavis.eval.report")
 
 
 def _modules_after(statement: str) -> set[str]:
@@ -12,10 +17,13 @@ def _modules_after(statement: str) -> set[str]:
     return set(out.split())
 
 
-def test_plugin_import_loads_no_simulator_or_policy_code():
-    loaded = _modules_after("import lerobot_env_tavis")
-    assert "lerobot_tavis" in loaded
-    assert not [m for m in HEAVY if m in loaded]
+def test_plugin_import_registers_the_env_type_and_loads_nothing_heavy():
+    baseline = _modules_after("import lerobot.envs.configs")
+    loaded = _modules_after("import lerobot_env_tavis; from lerobot.envs.configs import EnvConfig; "
+                            "assert EnvConfig.get_choice_class('tavis').__name__ == 'TavisEnvConfig'")
+    added = loaded - baseline
+    assert "lerobot_tavis" in added
+    assert not [m for m in added if m.startswith(HEAVY)]
 
 
 def test_task_catalog_and_camera_modes_need_no_mujoco():

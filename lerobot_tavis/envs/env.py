@@ -7,6 +7,8 @@ used in another (LeRobot's forkserver vector envs). All randomness comes from th
 
 from __future__ import annotations
 
+import zlib
+
 import gymnasium as gym
 import mujoco
 import numpy as np
@@ -93,7 +95,9 @@ class TavisEnv(gym.Env):
         self.action_space = _action_space(self._robot.neck_range_rad())
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
+        """Start an episode. The scene is drawn from (seed, task), so tasks that get the same seed list (as in
+        lerobot-eval) do not share layouts by accident; the same seed always gives the same episode."""
+        super().reset(seed=None if seed is None else scene_seed(seed, self.task))
         sim = self._ensure_sim()
         mujoco.mj_resetData(sim.model, sim.data)
         sim.controller.reset(sim.data)
@@ -187,6 +191,11 @@ class TavisEnv(gym.Env):
             "agent_pos": sim.controller.measured_state(sim.data).astype(np.float32),
             "joint_pos": sim.data.qpos[sim.world.robot_joint_qpos].astype(np.float32),
         }
+
+
+def scene_seed(seed: int, task: str) -> int:
+    """The generator seed of episode `seed` of `task`."""
+    return int(np.random.SeedSequence([int(seed), zlib.crc32(task.encode())]).generate_state(1)[0])
 
 
 def warm_up_action(rng: np.random.Generator) -> np.ndarray:

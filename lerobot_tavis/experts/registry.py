@@ -39,12 +39,13 @@ class EpisodeResult:
 
 
 def run_episode(env, seed: int, expert: Expert | None = None) -> EpisodeResult:
-    """Reset `env` with `seed` and let its demonstrator act until the episode ends."""
+    """Reset `env` (a TavisEnv, possibly wrapped) with `seed` and let its demonstrator act until the episode
+    ends."""
     env.reset(seed=seed)
-    expert = expert or make_expert(env, seed)
+    expert = expert or make_expert(env.unwrapped, seed)
     expert.reset()
     actions, info = [], {"is_success": False}
-    for step in range(env._max_episode_steps):
+    for _ in range(env.unwrapped._max_episode_steps):
         _, _, terminated, truncated, info = env.step(expert.act())
         actions.append(info["applied_action"])
         if terminated or truncated:

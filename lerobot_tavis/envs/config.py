@@ -1,0 +1,124 @@
+"""`--env.type=tavis`: the LeRobot EnvConfig of the benchmark, and the factory of its sub-envs.
+
+`task` is a suite (`tavis_head`, `tavis_hands`), a task name, or a comma list of either; `create_envs` returns
+`{suite: {task_id: VectorEnv}}` with every sub-env wrapped by LeRobot's `freeze_after_episode_end`. Simulators
+are created in the worker processes on their first reset. When an episode log is configured (by default
+`episodes.jsonl` in the output directory of the running lerobot-eval / lerobot-train), each finished episode
+appends one JSON line with its seed, success and GALT.
+"""
+
+from __future__ import annotations
+
+import inspect
+from dataclasses import dataclass, field
+from functools import partial
+from pathlib import Path
+
+import gymnasium as gym
+from lerobot.configs.types import FeatureType, PolicyFeature
+from lerobot.envs.configs import EnvConfig
+from lerobot.envs.utils import _LazyAsyncVectorEnv, freeze_after_episode_end
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs.modes import CAMERA_MODES, mode_cameras
+from lerobot_tavis.envs.tasks.catalog import SPLITS, SUITES, suite_tasks, task_info
+
+ROBOT_NAMES = ("gr1t2", "reachy2")
+EPISODE_LOG_NAME = "episodes.jsonl"
+
+
+def expand_tasks(spec: str) -> dict[str, list[str]]:
+    """`tavis_head`, `peeking_box` or `tavis_head,occluded_reach` -> {suite: [task, ...]}, in the given order."""
+    groups: dict[str, list[str]] = {}
+    for item in (part.strip() for part in spec.split(",")):
+        names = suite_tasks(item) if item in SUITES else (task_info(item).name,)
+        for name in names:
+            suite = task_info(name).suite
+            if name not in groups.setdefault(suite, []):
+                groups[suite].append(name)
+    return groups
+
+
+def make_tavis_env(task: str, robot: str, camera_mode: str, split: str, image_size: tuple[int, int],
+                   episode_length_s: float, episode_log: str | None = None, suite: str = "",
+                   task_id: int = 0) -> gym.Env:
+    """One sub-env (picklable through functools.partial for forkserver workers)."""
+    from lerobot_tavis.envs.env import TavisEnv  # imports MuJoCo: only in the process that simulates
+
+    env = TavisEnv(task, robot, camera_mode=camera_mode, split=split, image_size=tuple(image_size),
+                   episode_length_s=episode_length_s)
+    if episode_log:
+        from lerobot_tavis.eval.episode_log import EpisodeLogger
+
+        env = EpisodeLogger(env, episode_log, suite=suite, task_id=task_id)
+    return env
+
+
+@EnvConfig.register_subclass("tavis")
+@dataclass
+class TavisEnvConfig(EnvConfig):
+    task: str = "tavis_head"
+    fps: int = 20
+    robot: str = "gr1t2"
+    camera_mode: str = "headcam"
+    split: str = "id"
+    image_size: tuple[int, int] = (480, 640)
+    episode_length_s: float = 20.0
+    episode_log: str | None = None  # JSON-lines file; default: <output_dir>/episodes.jsonl of lerobot-eval/-train
+    features: dict[str, PolicyFeature] = field(default_factory=dict)
+    features_map: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self):
+        expand_tasks(self.task)  # raises a clear error for an unknown task or suite
+        if self.robot not in ROBOT_NAMES:
+            raise ValueError(f"robot must be one of {ROBOT_NAMES}, got {self.robot!r}")
+        mode_cameras(self.camera_mode)
+        if self.split not in SPLITS:
+            raise ValueError(f"split must be one of {SPLITS}, got {self.split!r}")
+        if self.fps != 20:
+            raise ValueError(f"fps is fixed by the benchmark at 20, got {self.fps}")
+        height, width = self.image_size
+        self.features = {"action": PolicyFeature(FeatureType.ACTION, (canonical.ACTION_DIM,)),
+                         "agent_pos": PolicyFeature(FeatureType.STATE, (canonical.ACTION_DIM,))}
+        self.features_map = {"action": "action", "agent_pos": "observation.state"}
+        for camera in CAMERA_MODES[self.camera_mode]:
+            self.features[f"pixels/{camera}"] = PolicyFeature(FeatureType.VISUAL, (height, width, 3))
+            self.features_map[f"pixels/{camera}"] = f"observation.images.{camera}"
+
+    @property
+    def gym_kwargs(self) -> dict:
+        return {"robot": self.robot, "camera_mode": self.camera_mode, "split": self.split,
+                "image_size": tuple(self.image_size), "episode_length_s": self.episode_length_s}
+
+    def create_envs(self, n_envs: int, use_async_envs: bool = False) -> dict[str, dict[int, gym.vector.VectorEnv]]:
+        log = self.episode_log or _pipeline_episode_log()
+        envs: dict[str, dict[int, gym.vector.VectorEnv]] = {}
+        for suite, tasks in expand_tasks(self.task).items():
+            envs[suite] = {}
+            for task_id, task in enumerate(tasks):
+                factory = partial(make_tavis_env, task, episode_log=str(log) if log else None, suite=suite,
+                                  task_id=task_id, **self.gym_kwargs)
+                if use_async_envs and n_envs > 1:
+                    probe = factory.func(task, **self.gym_kwargs)  # spaces only: builds no simulator
+                    envs[suite][task_id] = _LazyAsyncVectorEnv([factory] * n_envs, probe.observation_space,
+                                                               probe.action_space, probe.metadata)
+                else:
+                    envs[suite][task_id] = gym.vector.SyncVectorEnv(
+                        [freeze_after_episode_end(factory)] * n_envs,
+                        autoreset_mode=gym.vector.AutoresetMode.NEXT_STEP)
+        return envs
+
+
+def _pipeline_episode_log() -> Path | None:
+    """`<output_dir>/episodes.jsonl` of the lerobot-eval or lerobot-train run that is creating the envs.
+
+    LeRobot passes only the env config to `create_envs`, so the pipeline config (`cfg`, with its resolved
+    `output_dir`) is looked up in the calling frames.
+    """
+    frame = inspect.currentframe()
+    while frame is not None:
+        output_dir = getattr(frame.f_locals.get("cfg"), "output_dir", None)
+        if output_dir:
+            return Path(output_dir) / EPISODE_LOG_NAME
+        frame = frame.f_back
+    return None

@@ -1,0 +1,1 @@
+"""Evaluation: the per-episode log, the report, and the 96-episode protocol runner."""

@@ -1,0 +1,242 @@
+"""`tavis report <dir>`: success rates with Wilson 95% intervals and GALT, per task x split, from evaluations.
+
+Every `eval_info.json` under the directory (LeRobot's result of one lerobot-eval run) is joined with the
+`episodes.jsonl` next to it: per (suite, task_id), a log record belongs to episode `seed - start_seed` (the start
+seed is the smallest logged seed) and only episodes below LeRobot's `n_episodes` count, exactly the episodes
+LeRobot scored. Writes `results.json`, `results.md`, `success_rates.png` and `galt_<task>.png` into the directory.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from lerobot_tavis.envs.config import EPISODE_LOG_NAME
+from lerobot_tavis.envs.tasks.catalog import SPLITS, TASKS
+from lerobot_tavis.metrics.stats import wilson_interval
+
+EVAL_INFO_NAME = "eval_info.json"
+TASK_ORDER = list(TASKS)
+
+
+@dataclass
+class Cell:
+    """One task x split: its episodes' successes and GALT values."""
+
+    task: str
+    suite: str
+    split: str
+    successes: list[bool] = field(default_factory=list)
+    galt_s: list[float] = field(default_factory=list)
+    galt_reasons: dict[str, int] = field(default_factory=dict)
+
+    def summary(self) -> dict:
+        k, n = sum(self.successes), len(self.successes)
+        low, high = wilson_interval(k, n)
+        galt = np.array(self.galt_s)
+        return {
+            "task": self.task, "suite": self.suite, "split": self.split, "n": n, "successes": k,
+            "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high,
+            "galt_n_valid": len(galt), "galt_median_s": float(np.median(galt)) if len(galt) else None,
+            "galt_q1_s": float(np.percentile(galt, 25)) if len(galt) else None,
+            "galt_q3_s": float(np.percentile(galt, 75)) if len(galt) else None,
+            "galt_reasons": dict(sorted(self.galt_reasons.items())), "galt_values_s": list(self.galt_s),
+        }
+
+
+def read_episode_log(path: Path) -> list[dict]:
+    records = []
+    for number, line in enumerate(path.read_text().splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError as error:
+            raise ValueError(f"{path}:{number}: not a JSON line ({error.msg})") from None
+    return records
+
+
+def join(eval_dir: Path) -> tuple[list[dict], dict]:
+    """The scored episodes of one lerobot-eval output directory (log records with `episode_ix`), and its meta."""
+    info = json.loads((eval_dir / EVAL_INFO_NAME).read_text())
+    log_path = eval_dir / EPISODE_LOG_NAME
+    if not log_path.exists():
+        raise FileNotFoundError(f"{log_path} is missing: run the evaluation with the tavis env's episode log")
+    by_task: dict[tuple[str, int], list[dict]] = {}
+    for record in read_episode_log(log_path):
+        by_task.setdefault((record["suite"], record["task_id"]), []).append(record)
+    episodes, mismatches = [], 0
+    for task in info["per_task"]:
+        key = (task["task_group"], task["task_id"])
+        scored = task["metrics"]["successes"]
+        records = by_task.get(key, [])
+        if not records:
+            raise ValueError(f"{log_path} has no episode of {key[0]} task {key[1]}")
+        start = min(r["seed"] for r in records)
+        latest = {r["seed"] - start: r for r in records}  # a repeated seed: the last record wins
+        for ix, success in enumerate(scored):
+            if ix not in latest:
+                raise ValueError(f"{log_path}: episode {ix} of {key[0]} task {key[1]} (seed {start + ix}) "
+                                 "was scored by LeRobot but not logged")
+            record = {**latest[ix], "episode_ix": ix}
+            mismatches += bool(record["success"]) != bool(success)
+            episodes.append(record)
+    return episodes, {"source": str(eval_dir), "success_mismatches": mismatches}
+
+
+def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
+    cells: dict[tuple[str, str], Cell] = {}
+    sources = []
+    info_files = sorted(root.rglob(EVAL_INFO_NAME))
+    if not info_files:
+        raise FileNotFoundError(f"no {EVAL_INFO_NAME} under {root}")
+    for info_path in info_files:
+        episodes, meta = join(info_path.parent)
+        sources.append(meta)
+        for record in episodes:
+            cell = cells.setdefault((record["task"], record["split"]),
+                                    Cell(record["task"], record["suite"], record["split"]))
+            cell.successes.append(bool(record["success"]))
+            if record.get("galt_reason"):
+                cell.galt_reasons[record["galt_reason"]] = cell.galt_reasons.get(record["galt_reason"], 0) + 1
+            if record.get("galt_s") is not None:
+                cell.galt_s.append(float(record["galt_s"]))
+            meta.setdefault("robots", set()).add(record["robot"])
+            meta.setdefault("camera_modes", set()).add(record["camera_mode"])
+    for meta in sources:
+        meta["robots"], meta["camera_modes"] = sorted(meta.get("robots", ())), sorted(meta.get("camera_modes", ()))
+    return cells, sources
+
+
+def _order(cells) -> tuple[list[str], list[str]]:
+    tasks = sorted({task for task, _ in cells}, key=lambda t: (TASK_ORDER.index(t) if t in TASK_ORDER else 99, t))
+    splits = sorted({split for _, split in cells}, key=lambda s: (SPLITS.index(s) if s in SPLITS else 9, s))
+    return tasks, splits
+
+
+def build_report(root: Path) -> dict:
+    cells, sources = collect(root)
+    tasks, splits = _order(cells)
+    average = {}
+    for split in splits:
+        pooled = [s for (task, sp), cell in cells.items() if sp == split for s in cell.successes]
+        low, high = wilson_interval(sum(pooled), len(pooled))
+        average[split] = {"n": len(pooled), "successes": sum(pooled), "success_rate": sum(pooled) / len(pooled),
+                          "ci_low": low, "ci_high": high}
+    deltas = {}
+    for task in tasks:
+        if (task, "id") in cells and (task, "ood_spatial") in cells:
+            deltas[task] = (cells[(task, "id")].summary()["success_rate"]
+                            - cells[(task, "ood_spatial")].summary()["success_rate"])
+    return {"cells": [cells[(t, s)].summary() for t in tasks for s in splits if (t, s) in cells],
+            "average": average, "id_minus_ood_spatial": deltas, "sources": sources}
+
+
+def _pct(rate: float, low: float, high: float) -> str:
+    return f"{100 * rate:5.1f}% [{100 * low:4.1f}, {100 * high:5.1f}]"
+
+
+def markdown(report: dict) -> str:
+    cells = {(c["task"], c["split"]): c for c in report["cells"]}
+    tasks, splits = _order(cells)
+    has_delta = bool(report["id_minus_ood_spatial"])
+    robots = sorted({r for s in report["sources"] for r in s["robots"]})
+    modes = sorted({m for s in report["sources"] for m in s["camera_modes"]})
+    lines = [f"# TAVIS results: {', '.join(robots)}, {', '.join(modes)}", "",
+             "Success rate with Wilson 95% interval (n episodes).", "",
+             "| task | " + " | ".join(splits) + (" | id - ood_spatial |" if has_delta else " |"),
+             "|---|" + "---|" * (len(splits) + has_delta)]
+    for task in tasks:
+        row = [_pct(c["success_rate"], c["ci_low"], c["ci_high"]) + f" ({c['n']})" if (c := cells.get((task, s)))
+               else "" for s in splits]
+        if has_delta:
+            delta = report["id_minus_ood_spatial"].get(task)
+            row.append(f"{100 * delta:+.1f} pp" if delta is not None else "")
+        lines.append(f"| {task} | " + " | ".join(row) + " |")
+    avg = [_pct(a["success_rate"], a["ci_low"], a["ci_high"]) + f" ({a['n']})" for a in
+           (report["average"][s] for s in splits)]
+    lines += ["| **AVERAGE** (pooled) | " + " | ".join(avg) + (" | |" if has_delta else " |"), "",
+              "GALT (gaze-action lead time, s) over successful episodes of head-camera modes.", "",
+              "| task | split | median | IQR | n valid | reasons |", "|---|---|---|---|---|---|"]
+    for task in tasks:
+        for split in splits:
+            c = cells.get((task, split))
+            if c is None or not c["galt_reasons"]:
+                continue
+            median = f"{c['galt_median_s']:.2f}" if c["galt_median_s"] is not None else "-"
+            iqr = f"{c['galt_q1_s']:.2f} - {c['galt_q3_s']:.2f}" if c["galt_q1_s"] is not None else "-"
+            reasons = ", ".join(f"{k} {v}" for k, v in c["galt_reasons"].items())
+            lines.append(f"| {task} | {split} | {median} | {iqr} | {c['galt_n_valid']} | {reasons} |")
+    return "\n".join(lines) + "\n"
+
+
+def plot(report: dict, out_dir: Path) -> list[Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cells = {(c["task"], c["split"]): c for c in report["cells"]}
+    tasks, splits = _order(cells)
+    written = []
+    fig, ax = plt.subplots(figsize=(max(6.0, 1.3 * len(tasks) * max(1, len(splits)) / 2), 4.0))
+    width = 0.8 / len(splits)
+    for i, split in enumerate(splits):
+        xs, rates, errors = [], [], [[], []]
+        for j, task in enumerate(tasks):
+            if (c := cells.get((task, split))) is None:
+                continue
+            xs.append(j + (i - (len(splits) - 1) / 2) * width)
+            rates.append(100 * c["success_rate"])
+            errors[0].append(100 * (c["success_rate"] - c["ci_low"]))
+            errors[1].append(100 * (c["ci_high"] - c["success_rate"]))
+        ax.bar(xs, rates, width, yerr=errors, capsize=3, label=split)
+    ax.set_xticks(range(len(tasks)), tasks, rotation=30, ha="right")
+    ax.set_ylabel("success rate (%), Wilson 95% CI")
+    ax.set_ylim(0, 105)
+    ax.legend()
+    fig.tight_layout()
+    written.append(_save(fig, out_dir / "success_rates.png"))
+    for task in tasks:
+        values = {s: c["galt_values_s"] for s in splits if (c := cells.get((task, s))) is not None}
+        if not any(values.values()):
+            continue
+        fig, ax = plt.subplots(figsize=(5.0, 3.2))
+        ax.hist(list(values.values()), bins=np.arange(-0.5, 4.05, 0.1), label=list(values), stacked=True)
+        ax.set_xlabel("GALT (s)")
+        ax.set_ylabel("episodes")
+        ax.set_title(task)
+        ax.legend()
+        fig.tight_layout()
+        written.append(_save(fig, out_dir / f"galt_{task}.png"))
+        plt.close("all")
+    return written
+
+
+def _save(fig, path: Path) -> Path:
+    partial = path.with_name(f".{path.stem}.partial.png")
+    fig.savefig(partial, dpi=120)
+    os.replace(partial, path)
+    return path
+
+
+def write_report(root: str | Path) -> list[Path]:
+    """Build the report of every evaluation under `root` and write it there; returns the written files."""
+    root = Path(root)
+    report = build_report(root)
+    written = plot(report, root)
+    written.append(_write_text(root / "results.json", json.dumps(report, indent=2) + "\n"))
+    written.append(_write_text(root / "results.md", markdown(report)))
+    return written
+
+
+def _write_text(path: Path, text: str) -> Path:
+    partial = path.with_name(f".{path.name}.partial")
+    partial.write_text(text)
+    os.replace(partial, path)
+    return path
+
