@@ -153,8 +153,9 @@ class SkilledExpert(Expert):
         reach += [
             Move(pre, self.uniform(0.05, 0.1)),  # the arm catches up with the pre-grasp pose
             Move(grasp.action(self.ik, look), self.uniform(0.45, 0.6)),
-            # close with a ramp once there (the command crosses 0 halfway), then let the fingers squeeze
-            Move(grasp.action(self.ik, look, closed=True), self.uniform(0.2, 0.35)),
+            # close with a quick ramp once there (the command crosses 0 halfway; the fingers follow at their own
+            # speed), then let them squeeze
+            Move(grasp.action(self.ik, look, closed=True), self.uniform(0.12, 0.2)),
             Hold(self.uniform(0.15, 0.3)),
         ]
         return reach, self._carry_segments(grasp, name, carry_path)
