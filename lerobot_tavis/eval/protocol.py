@@ -44,6 +44,7 @@ class ProtocolConfig:
     n_episodes: int = 96
     camera_mode: str = "headcam"
     image_size: tuple[int, int] = (480, 640)
+    episode_length_s: float = 20.0
     policy_path: str | None = None  # None: the scripted demonstrators
     batch_size: int = 1
     device: str = "cpu"
@@ -85,7 +86,8 @@ def _run_policy_cell(cfg: ProtocolConfig, cell: Cell, out: Path) -> None:
     policy.pretrained_path = Path(cfg.policy_path)
     policy.device = cfg.device
     env = TavisEnvConfig(task=cell.suite, robot=cfg.robot, camera_mode=cfg.camera_mode, split=cell.split,
-                         image_size=cfg.image_size, episode_log=str(out / EPISODE_LOG_NAME))
+                         image_size=cfg.image_size, episode_length_s=cfg.episode_length_s,
+                         episode_log=str(out / EPISODE_LOG_NAME))
     eval_main(EvalPipelineConfig(env=env, eval=EvalConfig(n_episodes=cfg.n_episodes, batch_size=cfg.batch_size,
                                                           use_async_envs=cfg.batch_size > 1),
                                  policy=policy, output_dir=out, seed=cfg.seed))
@@ -121,8 +123,8 @@ def _expert_task(job) -> list[bool]:
     from lerobot_tavis.envs.config import make_tavis_env
     from lerobot_tavis.experts.registry import run_episode
 
-    env = make_tavis_env(task, cfg.robot, cfg.camera_mode, cell.split, cfg.image_size, 20.0, str(log_path),
-                         suite=cell.suite, task_id=task_id)
+    env = make_tavis_env(task, cfg.robot, cfg.camera_mode, cell.split, cfg.image_size, cfg.episode_length_s,
+                         str(log_path), suite=cell.suite, task_id=task_id)
     successes = []
     for ix in tqdm(range(cfg.n_episodes), desc=f"{cell.name} {task}", unit="ep", position=task_id):
         successes.append(run_episode(env, cfg.seed + ix).success)

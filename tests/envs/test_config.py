@@ -1,0 +1,80 @@
+"""`--env.type=tavis` as LeRobot uses it: registry, features, create_envs (sync and forkserver async), seeds."""
+
+import numpy as np
+import pytest
+from lerobot.envs.configs import EnvConfig
+from lerobot.envs.utils import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd, _LazyAsyncVectorEnv, preprocess_observation
+
+import lerobot_tavis  # noqa: F401  (registers the env type)
+from lerobot_tavis import canonical
+from lerobot_tavis.envs.config import TavisEnvConfig, expand_tasks
+from lerobot_tavis.envs.env import scene_seed
+
+
+def test_every_registered_env_type_is_default_constructible():
+    """What LeRobot's own registry test does, with the plugin loaded."""
+    for name in EnvConfig.get_known_choices():
+        assert EnvConfig.get_choice_class(name)().type == name
+    config = EnvConfig.get_choice_class("tavis")()
+    assert isinstance(config, TavisEnvConfig) and config.task == "tavis_head" and config.fps == 20
+
+
+@pytest.mark.parametrize("mode,cameras", [("headcam", ["head"]),
+                                          ("fixed_wrist", ["fixed", "left_wrist", "right_wrist"])])
+def test_features_follow_the_camera_mode(mode, cameras):
+    config = TavisEnvConfig(camera_mode=mode, image_size=(240, 320))
+    images = {k: v for k, v in config.features.items() if k.startswith("pixels/")}
+    assert sorted(images) == sorted(f"pixels/{c}" for c in cameras)
+    assert all(f.shape == (240, 320, 3) for f in images.values())
+    assert config.features_map["pixels/" + cameras[0]] == f"observation.images.{cameras[0]}"
+    assert config.features_map["agent_pos"] == "observation.state"
+    assert config.features["action"].shape == (19,)
+
+
+def test_task_spec_expands_to_suites():
+    assert expand_tasks("tavis_hands") == {"tavis_hands": ["peeking_box", "occluded_reach",
+                                                           "blocked_clutter_pick_cube"]}
+    assert expand_tasks("wait_then_act, peeking_box,conditional_pick") == {
+        "tavis_head": ["wait_then_act", "conditional_pick"], "tavis_hands": ["peeking_box"]}
+
+
+@pytest.mark.parametrize("kwargs,message", [({"task": "tavis_legs"}, "task must be one of"),
+                                            ({"robot": "spot"}, "robot must be one of"),
+                                            ({"camera_mode": "eye"}, "camera_mode must be one of"),
+                                            ({"split": "ood"}, "split must be one of")])
+def test_bad_config_values_are_rejected(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        TavisEnvConfig(**kwargs)
+
+
+def test_sync_create_envs_wraps_every_sub_env_and_runs():
+    config = TavisEnvConfig(task="tavis_hands", image_size=(24, 32), camera_mode="head_wrist")
+    envs = config.create_envs(n_envs=2, use_async_envs=False)
+    assert list(envs) == ["tavis_hands"] and list(envs["tavis_hands"]) == [0, 1, 2]
+    vec = envs["tavis_hands"][1]
+    assert all(isinstance(e, FreezeAfterEpisodeEnd) for e in vec.envs)
+    obs, info = vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+    batch = preprocess_observation(obs)
+    assert batch["observation.images.head"].shape == (2, 3, 24, 32)
+    assert batch["observation.state"].shape == (2, 19)
+    assert list(vec.call("task")) == ["occluded_reach"] * 2
+    vec.step(np.tile(canonical.rest_action(), (2, 1)))
+    for vecs in envs.values():
+        for v in vecs.values():
+            v.close()
+
+
+def test_async_create_envs_run_in_forkserver_workers():
+    config = TavisEnvConfig(task="wait_then_act", image_size=(24, 32))
+    vec = config.create_envs(n_envs=2, use_async_envs=True)["tavis_head"][0]
+    assert isinstance(vec, _LazyAsyncVectorEnv)
+    obs, _ = vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+    assert obs["pixels"]["head"].shape == (2, 24, 32, 3)
+    obs, reward, terminated, truncated, info = vec.step(np.tile(canonical.rest_action(), (2, 1)))
+    assert obs["agent_pos"].shape == (2, 19)
+    vec.close()
+
+
+def test_tasks_given_the_same_seed_get_their_own_scene():
+    assert scene_seed(1000, "clutter_pick_cube") != scene_seed(1000, "blocked_clutter_pick_cube")
+    assert scene_seed(1000, "clutter_pick_cube") == scene_seed(1000, "clutter_pick_cube")

@@ -1,0 +1,68 @@
+"""The episode log: one line per genuine episode, with GALT for successful head-camera episodes."""
+
+import json
+
+import gymnasium as gym
+import numpy as np
+from lerobot.envs.utils import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd
+
+from lerobot_tavis import canonical
+from lerobot_tavis.eval.episode_log import GALT_FIELDS, EpisodeLogger
+from tests.test_galt import episode
+
+
+class ScriptedEnv(gym.Env):
+    """Replays a fixed action trajectory as the 'applied' actions and succeeds on its last step."""
+
+    metadata = {"render_fps": 20}
+    observation_space = gym.spaces.Box(-1, 1, (1,))
+    action_space = gym.spaces.Box(-np.inf, np.inf, (19,))
+
+    def __init__(self, actions, success=True, camera_mode="headcam"):
+        self.actions, self.success = actions, success
+        self.robot_name, self.task, self.split, self.camera_mode = "gr1t2", "clutter_pick_lift", "id", camera_mode
+        self.task_description = "Lift the red soup can off the table."
+
+    def reset(self, *, seed=None, options=None):
+        self.t = 0
+        return np.zeros(1, np.float32), {"is_success": False}
+
+    def step(self, action):
+        applied = self.actions[self.t]
+        self.t += 1
+        done = self.t == len(self.actions)
+        success = done and self.success
+        return np.zeros(1, np.float32), float(success), success, done and not success, {
+            "is_success": success, "applied_action": applied}
+
+
+def _run(env, seed, steps):
+    env.reset(seed=seed, options={NEW_ROLLOUT_OPTION: True})
+    info = {}
+    for _ in range(steps):
+        *_, info = env.step(canonical.rest_action())
+    return info
+
+
+def test_a_successful_episode_is_logged_once_with_its_galt(tmp_path):
+    actions = episode(20, 3.0, 1.0, hand=(1.4, 2.0), grasp_s=2.0)
+    log = tmp_path / "episodes.jsonl"
+    env = FreezeAfterEpisodeEnd(EpisodeLogger(ScriptedEnv(actions), log, suite="tavis_head", task_id=3))
+    info = _run(env, 1005, len(actions) + 5)  # extra steps hit the frozen terminal transition
+    env.reset()  # an autoreset: replayed, not a new episode
+    (record,) = [json.loads(line) for line in log.read_text().splitlines()]
+    assert record["seed"] == 1005 and record["success"] and record["length_steps"] == len(actions)
+    assert record["suite"] == "tavis_head" and record["task_id"] == 3 and record["task"] == "clutter_pick_lift"
+    assert record["galt_reason"] == "ok" and abs(record["galt_s"] - 1.0) < 0.1 and record["galt_arm"] == "right"
+    assert info["galt_s"] == record["galt_s"]
+
+
+def test_no_galt_for_failures_or_fixed_camera_modes(tmp_path):
+    actions = episode(20, 3.0, 1.0, hand=(1.4, 2.0), grasp_s=2.0)
+    log = tmp_path / "episodes.jsonl"
+    for env in (EpisodeLogger(ScriptedEnv(actions, success=False), log, "tavis_head", 0),
+                EpisodeLogger(ScriptedEnv(actions, camera_mode="fixedcam"), log, "tavis_head", 0)):
+        _run(env, 7, len(actions))
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    assert len(records) == 2 and [r["success"] for r in records] == [False, True]
+    assert all(r[field] is None for r in records for field in GALT_FIELDS)

@@ -1,0 +1,68 @@
+"""The protocol runner (demonstrators and a policy checkpoint through LeRobot's eval) and lerobot-eval itself."""
+
+import json
+import os
+import subprocess
+import sys
+
+from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
+
+
+def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
+    cfg = ProtocolConfig(out_dir=tmp_path, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2,
+                         image_size=(24, 32), workers=1)
+    written = {p.name for p in run_protocol(cfg)}
+    assert {"results.md", "results.json", "success_rates.png"} <= written
+    cell = tmp_path / "tavis_hands__id"
+    info = json.loads((cell / "eval_info.json").read_text())
+    assert [t["task_id"] for t in info["per_task"]] == [0, 1, 2]
+    records = [json.loads(line) for line in (cell / "episodes.jsonl").read_text().splitlines()]
+    assert sorted((r["task"], r["seed"]) for r in records) == sorted(
+        (task, seed) for task in ("peeking_box", "occluded_reach", "blocked_clutter_pick_cube")
+        for seed in (1000, 1001))
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert sum(c["n"] for c in results["cells"]) == 6
+    before = (cell / "eval_info.json").stat().st_mtime_ns
+    run_protocol(cfg)
+    assert "tavis_hands__id: done already, skipped" in capsys.readouterr().out
+    assert (cell / "eval_info.json").stat().st_mtime_ns == before
+    assert not list(tmp_path.glob(".*.partial"))
+
+
+def _diffusion_checkpoint(path, image_size):
+    from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
+    from lerobot.policies.factory import make_policy, make_pre_post_processors
+
+    from lerobot_tavis.envs.config import TavisEnvConfig
+
+    config = DiffusionConfig(pretrained_backbone_weights=None, device="cpu", push_to_hub=False,
+                             down_dims=(16, 32, 64), horizon=16, n_action_steps=8, num_inference_steps=2)
+    policy = make_policy(config, env_cfg=TavisEnvConfig(image_size=image_size))
+    policy.save_pretrained(path)
+    for processor in make_pre_post_processors(config, dataset_stats=None):
+        processor.save_pretrained(path)
+
+
+def test_policy_protocol_runs_through_lerobot_eval(tmp_path):
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("ood_init_pose",),
+                         n_episodes=1, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"))
+    run_protocol(cfg)
+    results = json.loads((tmp_path / "eval" / "results.json").read_text())
+    assert [(c["task"], c["split"], c["n"]) for c in results["cells"]] == [
+        (task, "ood_init_pose", 1) for task in ("conditional_pick", "wait_then_act", "clutter_pick_cube",
+                                                 "clutter_pick_lift", "multi_shelf_scan")]
+
+
+def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path):
+    command = [os.path.join(os.path.dirname(sys.executable), "lerobot-eval"), "--env.type=tavis",
+               "--env.task=conditional_pick", "--env.image_size=[32, 48]", "--env.episode_length_s=0.5",
+               "--policy.type=diffusion", "--policy.pretrained_backbone_weights=null", "--policy.device=cpu",
+               "--policy.down_dims=[16, 32, 64]", "--policy.num_inference_steps=2", "--eval.n_episodes=2",
+               "--eval.batch_size=2", "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'out'}"]
+    subprocess.run(command, check=True, capture_output=True, text=True, env={**os.environ, "HF_HUB_OFFLINE": "1"})
+    info = json.loads((tmp_path / "out" / "eval_info.json").read_text())
+    assert info["per_task"][0]["task_group"] == "tavis_head"
+    records = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
+    assert sorted(r["seed"] for r in records) == [1000, 1001]
+    assert all("galt_s" in r and r["length_steps"] == 10 for r in records)

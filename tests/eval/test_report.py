@@ -1,0 +1,70 @@
+"""`tavis report`: the join with eval_info.json, Wilson intervals, pooled average, deltas, GALT, plots."""
+
+import json
+
+import pytest
+
+from lerobot_tavis.eval.report import build_report, join, markdown, write_report
+
+
+def _record(task, task_id, seed, success, split="id", galt=None):
+    return {"robot": "gr1t2", "suite": "tavis_head", "task": task, "task_id": task_id, "split": split,
+            "camera_mode": "headcam", "seed": seed, "success": success, "length_steps": 100,
+            "galt_s": galt, "galt_reason": ("ok" if galt is not None else None) if success else None}
+
+
+def _eval_dir(path, split, outcomes: dict[str, list[bool]], extra=1):
+    """A lerobot-eval output: eval_info.json scores len(outcomes) episodes per task; the log has `extra` more."""
+    path.mkdir(parents=True)
+    per_task, lines = [], []
+    for task_id, (task, successes) in enumerate(outcomes.items()):
+        per_task.append({"task_group": "tavis_head", "task_id": task_id, "metrics": {"successes": successes}})
+        for ix, success in enumerate(successes + [True] * extra):  # the last batch's surplus episodes
+            lines.append(_record(task, task_id, 1000 + ix, success, split, galt=0.5 + 0.1 * ix if success else None))
+    (path / "eval_info.json").write_text(json.dumps({"per_task": per_task}))
+    (path / "episodes.jsonl").write_text("".join(json.dumps(line) + "\n" for line in reversed(lines)))
+
+
+def test_join_keeps_exactly_the_episodes_lerobot_scored(tmp_path):
+    _eval_dir(tmp_path / "a", "id", {"conditional_pick": [True, False, True]}, extra=2)
+    episodes, meta = join(tmp_path / "a")
+    assert sorted(e["episode_ix"] for e in episodes) == [0, 1, 2] and meta["success_mismatches"] == 0
+
+
+def test_report_rates_intervals_average_and_deltas(tmp_path):
+    _eval_dir(tmp_path / "id", "id", {"conditional_pick": [True] * 48 + [False] * 48,
+                                      "wait_then_act": [True] * 96})
+    _eval_dir(tmp_path / "ood", "ood_spatial", {"conditional_pick": [False] * 96, "wait_then_act": [True] * 96})
+    report = build_report(tmp_path)
+    cells = {(c["task"], c["split"]): c for c in report["cells"]}
+    half = cells[("conditional_pick", "id")]
+    assert (half["n"], half["successes"], round(100 * half["ci_low"], 1), round(100 * half["ci_high"], 1)) == (
+        96, 48, 40.2, 59.8)
+    assert round(100 * cells[("conditional_pick", "ood_spatial")]["ci_high"], 1) == 3.8
+    assert report["average"]["id"]["successes"] == 144 and report["average"]["id"]["n"] == 192
+    assert report["id_minus_ood_spatial"]["conditional_pick"] == pytest.approx(0.5)
+    assert cells[("wait_then_act", "id")]["galt_n_valid"] == 96
+    assert cells[("wait_then_act", "id")]["galt_median_s"] == pytest.approx(0.5 + 0.1 * 47.5)
+    text = markdown(report)
+    assert "| conditional_pick |  50.0% [40.2,  59.8] (96) |   0.0% [ 0.0,   3.8] (96) | +50.0 pp |" in text
+    assert "**AVERAGE**" in text
+
+
+def test_write_report_writes_tables_and_plots_atomically(tmp_path):
+    _eval_dir(tmp_path / "id", "id", {"clutter_pick_lift": [True, True, False]})
+    written = {p.name for p in write_report(tmp_path)}
+    assert {"results.json", "results.md", "success_rates.png", "galt_clutter_pick_lift.png"} <= written
+    assert json.loads((tmp_path / "results.json").read_text())["cells"][0]["n"] == 3
+    assert not list(tmp_path.glob(".*partial*"))
+
+
+def test_missing_or_corrupt_logs_give_clear_errors(tmp_path):
+    _eval_dir(tmp_path / "a", "id", {"conditional_pick": [True]})
+    (tmp_path / "a" / "episodes.jsonl").write_text('{"suite": "tavis_head"\n')
+    with pytest.raises(ValueError, match=r"episodes.jsonl:1: not a JSON line"):
+        join(tmp_path / "a")
+    (tmp_path / "a" / "episodes.jsonl").unlink()
+    with pytest.raises(FileNotFoundError, match="episodes.jsonl is missing"):
+        join(tmp_path / "a")
+    with pytest.raises(FileNotFoundError, match="no eval_info.json"):
+        build_report(tmp_path / "a" / "nothing")
