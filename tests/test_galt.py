@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from lerobot_tavis import canonical
-from lerobot_tavis.metrics.galt import GaltParams, compute_galt
+from lerobot_tavis.metrics.galt import GaltParams, compute_galt, galt_per_grasp, grasp_events, wrist_lead_per_grasp
 
 
 def episode(fps: float, duration_s: float, head_until_s: float | None, hand=None, grasp_s=None, side="right",
@@ -106,3 +106,72 @@ def test_reason_priority_prefers_the_more_severe_arm_reason():
 def test_bad_input_shape():
     with pytest.raises(ValueError, match=r"\(T, D\)"):
         compute_galt(np.zeros(19), fps=20)
+
+
+def two_grasps(fps: float) -> np.ndarray:
+    """Right hand grasps at 2.0 s (head settled at 1.0 s), releases at 3.0 s; the head turns again from 3.0 to
+    3.5 s; the left hand reaches 4.2-5.0 s and grasps at 5.0 s."""
+    actions = episode(fps, 7.0, 1.0, hand=(1.4, 2.0), grasp_s=2.0, side="right")
+    t = np.arange(len(actions)) / fps
+    actions[t >= 3.0, canonical.RIGHT.gripper] = -1.0
+    actions[:, canonical.HEAD_YAW] = 0.6 * np.clip((t - 3.0) / 0.5, 0.0, 1.0)
+    left = episode(fps, 7.0, None, hand=(4.2, 5.0), grasp_s=5.0, side="left")
+    actions[:, canonical.LEFT.position], actions[:, canonical.LEFT.gripper] = (
+        left[:, canonical.LEFT.position], left[:, canonical.LEFT.gripper])
+    return actions
+
+
+@pytest.mark.parametrize("fps", [20, 60])
+def test_galt_per_grasp_measures_every_closing(fps):
+    actions = two_grasps(fps)
+    assert grasp_events(actions) == [("right", round(2.0 * fps)), ("left", round(5.0 * fps))]
+    first, second = galt_per_grasp(actions, fps=fps)
+    assert (first.arm, second.arm) == ("right", "left")
+    assert first.t_grasp_s == pytest.approx(2.0) and second.t_grasp_s == pytest.approx(5.0)
+    assert first.galt.reason == "ok" and first.galt.galt_s == pytest.approx(1.0, abs=0.1)
+    assert second.galt.reason == "ok" and second.galt.galt_s == pytest.approx(1.5, abs=0.1)
+    # the reference looks only at each arm's last gripper change: the right one is the release
+    reference = compute_galt(actions, fps=fps)
+    assert reference.arm == "left" and reference.per_arm["right"].anchor == round(3.0 * fps)
+
+
+def test_galt_per_grasp_of_a_single_grasp_equals_the_reference():
+    actions = episode(20, 5.0, 1.0, hand=(1.4, 2.0), grasp_s=2.0)
+    (grasp,) = galt_per_grasp(actions, fps=20)
+    assert grasp.galt == compute_galt(actions, fps=20).per_arm["right"]
+    assert galt_per_grasp(actions[:9], fps=20) == []
+
+
+def peek_then_grasp(fps: float, look_from_s: float = 1.0) -> np.ndarray:
+    """The right hand moves to a peek pose (done at `look_from_s`, wrist turned 0.5 rad), looks until 2.0 s,
+    reaches 2.0-2.6 s and grasps at 2.6 s; the head is still from the start."""
+    actions = episode(fps, 5.0, None, hand=(2.0, 2.6), grasp_s=2.6)
+    t = np.arange(len(actions)) / fps
+    turn = 0.5 * np.clip(t / look_from_s, 0.0, 1.0)  # about the x axis, reaching look_from_s
+    actions[:, canonical.RIGHT.quaternion] = np.stack(
+        [np.cos(turn / 2), np.sin(turn / 2), np.zeros_like(t), np.zeros_like(t)], axis=1)
+    return actions
+
+
+@pytest.mark.parametrize("fps", [20, 60])
+def test_wrist_lead_is_the_time_from_the_last_look_to_the_grasp(fps):
+    (lead,) = wrist_lead_per_grasp(peek_then_grasp(fps), fps=fps)
+    assert lead.arm == "right" and lead.reason == "ok"
+    assert lead.t_hand_onset_s == pytest.approx(2.0, abs=2 / fps)
+    # settled at 1.0 s (refined by up to 0.05 rad / 0.5 rad/s earlier), grasp at 2.6 s
+    assert lead.lead_s == pytest.approx(1.6, abs=0.1) and lead.t_settle_s <= 1.0 + 1e-9
+
+
+def test_wrist_lead_needs_a_still_camera_before_the_reach():
+    actions = peek_then_grasp(20, look_from_s=2.0)  # still turning when the reach starts
+    assert wrist_lead_per_grasp(actions, fps=20)[0].reason == "no_fixation"
+
+
+def test_wrist_lead_of_a_hand_resting_since_the_start_is_an_outlier():
+    actions = episode(20, 8.0, 0.5, hand=(5.4, 6.0), grasp_s=6.0)
+    assert wrist_lead_per_grasp(actions, fps=20)[0].reason == "outlier_high"
+
+
+def test_wrist_lead_without_hand_onset():
+    actions = episode(20, 4.0, 1.0, hand=(1.0, 1.5), grasp_s=2.0)
+    assert wrist_lead_per_grasp(actions, fps=20)[0].reason == "no_hand_onset"

@@ -3,7 +3,8 @@
 The wrapper sits inside LeRobot's `FreezeAfterEpisodeEnd`, so it sees each genuine episode once. It records the
 actions the env actually applied (after clipping, and with the neck zeroed in fixed-camera modes) and, when an
 episode ends, computes GALT from them at 20 Hz for successful episodes of head-camera modes, as the reference
-does; the GALT fields are also added to that step's `info`.
+does; the GALT fields are also added to that step's `info`. Successful TAVIS-Hands episodes also get the wrist
+analogue of their final grasp (`wrist_lead_*`, any camera mode: it is read from the hand's motion).
 """
 
 from __future__ import annotations
@@ -16,10 +17,11 @@ import numpy as np
 
 from lerobot_tavis.envs.modes import neck_locked
 from lerobot_tavis.envs.physics import POLICY_HZ
-from lerobot_tavis.metrics.galt import compute_galt
+from lerobot_tavis.metrics.galt import compute_galt, wrist_lead_per_grasp
 
 GALT_FIELDS = ("galt_s", "galt_reason", "galt_arm", "galt_t_head_arrival_s", "galt_t_hand_arrival_s",
                "galt_t_hand_onset_s", "galt_arm_reach_s")
+WRIST_FIELDS = ("wrist_lead_s", "wrist_lead_reason", "wrist_lead_arm")
 
 
 def galt_fields(actions: np.ndarray | None) -> dict:
@@ -30,6 +32,15 @@ def galt_fields(actions: np.ndarray | None) -> dict:
     return {"galt_s": result.galt_s, "galt_reason": result.reason, "galt_arm": result.arm,
             "galt_t_head_arrival_s": result.t_head_arrival_s, "galt_t_hand_arrival_s": result.t_hand_arrival_s,
             "galt_t_hand_onset_s": result.t_hand_onset_s, "galt_arm_reach_s": result.arm_reach_s}
+
+
+def wrist_fields(actions: np.ndarray | None) -> dict:
+    """The wrist analogue of an episode's final grasp as flat log fields (all None when not computed)."""
+    leads = wrist_lead_per_grasp(actions, fps=POLICY_HZ) if actions is not None else []
+    if not leads:
+        return dict.fromkeys(WRIST_FIELDS)
+    final = leads[-1]
+    return {"wrist_lead_s": final.lead_s, "wrist_lead_reason": final.reason, "wrist_lead_arm": final.arm}
 
 
 class EpisodeLogger(gym.Wrapper):
@@ -56,12 +67,14 @@ class EpisodeLogger(gym.Wrapper):
 
     def _record(self, success: bool) -> dict:
         env = self.env.unwrapped
+        actions = np.array(self._actions)
         with_galt = success and not neck_locked(env.camera_mode)
+        with_wrist = success and self.suite == "tavis_hands"
         return {
             "robot": env.robot_name, "suite": self.suite, "task": env.task, "task_id": self.task_id,
             "split": env.split, "camera_mode": env.camera_mode, "seed": self._seed, "success": success,
             "length_steps": len(self._actions), "prompt": env.task_description,
-            **galt_fields(np.array(self._actions) if with_galt else None),
+            **galt_fields(actions if with_galt else None), **wrist_fields(actions if with_wrist else None),
         }
 
     def _append(self, record: dict) -> None:

@@ -24,27 +24,48 @@ TASK_ORDER = list(TASKS)
 
 
 @dataclass
+class LeadTimes:
+    """One cell's lead times (s, valid episodes only) and how often its detector gave each reason."""
+
+    values_s: list[float] = field(default_factory=list)
+    reasons: dict[str, int] = field(default_factory=dict)
+
+    def add(self, value_s: float | None, reason: str | None) -> None:
+        if reason:
+            self.reasons[reason] = self.reasons.get(reason, 0) + 1
+        if value_s is not None:
+            self.values_s.append(float(value_s))
+
+    def summary(self, prefix: str) -> dict:
+        values = np.array(self.values_s)
+        quartiles = np.percentile(values, [25, 50, 75]) if len(values) else [None] * 3
+        return {f"{prefix}_n_valid": len(values), f"{prefix}_median_s": _float(quartiles[1]),
+                f"{prefix}_q1_s": _float(quartiles[0]), f"{prefix}_q3_s": _float(quartiles[2]),
+                f"{prefix}_reasons": dict(sorted(self.reasons.items())), f"{prefix}_values_s": list(self.values_s)}
+
+
+def _float(value) -> float | None:
+    return None if value is None else float(value)
+
+
+@dataclass
 class Cell:
-    """One task x split: its episodes' successes and GALT values."""
+    """One task x split: its episodes' successes, GALT and (TAVIS-Hands) wrist lead times."""
 
     task: str
     suite: str
     split: str
     successes: list[bool] = field(default_factory=list)
-    galt_s: list[float] = field(default_factory=list)
-    galt_reasons: dict[str, int] = field(default_factory=dict)
+    galt: LeadTimes = field(default_factory=LeadTimes)
+    wrist_lead: LeadTimes = field(default_factory=LeadTimes)
 
     def summary(self) -> dict:
         k, n = sum(self.successes), len(self.successes)
         low, high = wilson_interval(k, n)
-        galt = np.array(self.galt_s)
         return {
             "task": self.task, "suite": self.suite, "split": self.split, "n": n, "successes": k,
             "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high,
-            "galt_n_valid": len(galt), "galt_median_s": float(np.median(galt)) if len(galt) else None,
-            "galt_q1_s": float(np.percentile(galt, 25)) if len(galt) else None,
-            "galt_q3_s": float(np.percentile(galt, 75)) if len(galt) else None,
-            "galt_reasons": dict(sorted(self.galt_reasons.items())), "galt_values_s": list(self.galt_s),
+            **self.galt.summary("galt"), **self.wrist_lead.summary("wrist_lead"),
         }
 
 
@@ -101,10 +122,8 @@ def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
             cell = cells.setdefault((record["task"], record["split"]),
                                     Cell(record["task"], record["suite"], record["split"]))
             cell.successes.append(bool(record["success"]))
-            if record.get("galt_reason"):
-                cell.galt_reasons[record["galt_reason"]] = cell.galt_reasons.get(record["galt_reason"], 0) + 1
-            if record.get("galt_s") is not None:
-                cell.galt_s.append(float(record["galt_s"]))
+            cell.galt.add(record.get("galt_s"), record.get("galt_reason"))
+            cell.wrist_lead.add(record.get("wrist_lead_s"), record.get("wrist_lead_reason"))
             meta.setdefault("robots", set()).add(record["robot"])
             meta.setdefault("camera_modes", set()).add(record["camera_mode"])
     for meta in sources:
@@ -159,19 +178,33 @@ def markdown(report: dict) -> str:
         lines.append(f"| {task} | " + " | ".join(row) + " |")
     avg = [_pct(a["success_rate"], a["ci_low"], a["ci_high"]) + f" ({a['n']})" for a in
            (report["average"][s] for s in splits)]
-    lines += ["| **AVERAGE** (pooled) | " + " | ".join(avg) + (" | |" if has_delta else " |"), "",
-              "GALT (gaze-action lead time, s) over successful episodes of head-camera modes.", "",
-              "| task | split | median | IQR | n valid | reasons |", "|---|---|---|---|---|---|"]
-    for task in tasks:
-        for split in splits:
-            c = cells.get((task, split))
-            if c is None or not c["galt_reasons"]:
-                continue
-            median = f"{c['galt_median_s']:.2f}" if c["galt_median_s"] is not None else "-"
-            iqr = f"{c['galt_q1_s']:.2f} - {c['galt_q3_s']:.2f}" if c["galt_q1_s"] is not None else "-"
-            reasons = ", ".join(f"{k} {v}" for k, v in c["galt_reasons"].items())
-            lines.append(f"| {task} | {split} | {median} | {iqr} | {c['galt_n_valid']} | {reasons} |")
+    lines += ["| **AVERAGE** (pooled) | " + " | ".join(avg) + (" | |" if has_delta else " |")]
+    lines += _lead_table(cells, tasks, splits, "galt",
+                         "GALT (gaze-action lead time, s) over successful episodes of head-camera modes.")
+    lines += _lead_table(cells, tasks, splits, "wrist_lead",
+                         "Wrist lead (s): the grasping hand's wrist camera settles before the final grasp "
+                         "(successful TAVIS-Hands episodes).")
     return "\n".join(lines) + "\n"
+
+
+def _lead_table(cells: dict, tasks: list[str], splits: list[str], prefix: str, caption: str) -> list[str]:
+    """Median, IQR, n valid and reason counts of one lead time (`galt` or `wrist_lead`) per task x split."""
+    rows = []
+    for task, split in ((t, s) for t in tasks for s in splits):
+        cell = cells.get((task, split))
+        if cell is None or not cell[f"{prefix}_reasons"]:
+            continue
+        median, q1, q3 = (cell[f"{prefix}_{key}_s"] for key in ("median", "q1", "q3"))
+        reasons = ", ".join(f"{k} {v}" for k, v in cell[f"{prefix}_reasons"].items())
+        rows.append(f"| {task} | {split} | {_seconds(median)} | {_seconds(q1)} - {_seconds(q3)} "
+                    f"| {cell[f'{prefix}_n_valid']} | {reasons} |")
+    if not rows:
+        return []
+    return ["", caption, "", "| task | split | median | IQR | n valid | reasons |", "|---|---|---|---|---|---|", *rows]
+
+
+def _seconds(value: float | None) -> str:
+    return "-" if value is None else f"{value:.2f}"
 
 
 def plot(report: dict, out_dir: Path) -> list[Path]:

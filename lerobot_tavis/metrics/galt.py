@@ -17,6 +17,10 @@ included, so numbers compare with published ones:
    (no_fixation = outlier_low = outlier_high > no_hand_onset > no_grasp, ties to the left arm).
 
 Step counts use Python's round (half to even) like the reference.
+
+Two extensions, kept apart from the reference result: `galt_per_grasp` measures every grasp (each closing of
+a gripper) the way the reference measures the final gripper event, and `wrist_lead_per_grasp` is the wrist-camera
+analogue for TAVIS-Hands: how long before a grasp the camera on the grasping hand settled for its last look.
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ class GaltParams:
     outlier_min_s: float = -0.5
     outlier_max_s: float = 4.0
     arrival_margin_rad: float = 0.05
+    wrist_arrival_margin_m: float = 0.01  # extension only: the wrist analogue's settle refinement
 
     def steps(self, fps: float) -> dict[str, int]:
         return {
@@ -59,9 +64,14 @@ class ActionLayout:
     neck: tuple[int, ...] = (14, 15, 16)
     left_gripper: int = 17
     right_gripper: int = 18
+    left_orientation: tuple[int, ...] = (3, 4, 5, 6)  # quaternion w, x, y, z (wrist analogue only)
+    right_orientation: tuple[int, ...] = (10, 11, 12, 13)
 
     def arms(self) -> dict[str, tuple[tuple[int, ...], int]]:
         return {"left": (self.left_hand, self.left_gripper), "right": (self.right_hand, self.right_gripper)}
+
+    def orientation(self, side: str) -> tuple[int, ...]:
+        return self.left_orientation if side == "left" else self.right_orientation
 
 
 @dataclass(frozen=True)
@@ -134,8 +144,13 @@ def _arm_galt(actions, fps, params, steps, hand, gripper, neck, neck_speed) -> A
     events = binarised_events(actions[:, gripper])
     if not len(events):
         return ArmGalt("no_grasp")
-    anchor = int(events[-1])
-    onset = hand_onset(channel_speed(actions[:, list(hand)], fps), anchor, params.v_hand_thresh, steps["m"])
+    return _galt_at(int(events[-1]), channel_speed(actions[:, list(hand)], fps), fps, params, steps, neck,
+                    neck_speed)
+
+
+def _galt_at(anchor, hand_speed, fps, params, steps, neck, neck_speed) -> ArmGalt:
+    """Steps 3b-e of the reference for one gripper event at step `anchor`."""
+    onset = hand_onset(hand_speed, anchor, params.v_hand_thresh, steps["m"])
     if onset is None:
         return ArmGalt("no_hand_onset", anchor=anchor)
     arrival = head_arrival(neck, neck_speed, anchor, params, steps)
@@ -152,9 +167,7 @@ def _arm_galt(actions, fps, params, steps, hand, gripper, neck, neck_speed) -> A
 def compute_galt(actions, fps: float, params: GaltParams = GaltParams(),
                  layout: ActionLayout = ActionLayout()) -> GaltResult:
     """GALT of one episode from its (T, D) commanded actions sampled at `fps` (see the module docstring)."""
-    actions = np.asarray(actions, dtype=float)
-    if actions.ndim != 2:
-        raise ValueError(f"actions must be a (T, D) array, got shape {actions.shape}")
+    actions = _checked(actions)
     if len(actions) < MIN_STEPS:
         return GaltResult(None, "too_short")
     steps = params.steps(fps)
@@ -176,3 +189,115 @@ def _combine(per_arm: dict[str, ArmGalt], fps: float) -> GaltResult:
     arm = per_arm[side]
     return GaltResult(arm.galt_s, arm.reason, side, arm.head_arrival / fps, arm.anchor / fps, arm.onset / fps,
                       (arm.anchor - arm.onset) / fps, per_arm)
+
+
+# --- Extensions (not part of the reference detector) ---------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class GraspGalt:
+    """GALT of one grasp: `arm` closed its gripper at step `anchor` (t_grasp_s = anchor / fps)."""
+
+    arm: str
+    t_grasp_s: float
+    galt: ArmGalt
+
+
+@dataclass(frozen=True)
+class WristLead:
+    """How long before one grasp the grasping hand's wrist camera settled for its last look.
+
+    reason: `ok`, `no_hand_onset` (as the reference), `no_fixation` (the camera still turns when the hand starts
+    its reach) or `outlier_high` (settled more than 4.0 s before the grasp: a rest, not a look).
+    """
+
+    arm: str
+    t_grasp_s: float
+    reason: str
+    lead_s: float | None = None
+    t_settle_s: float | None = None
+    t_hand_onset_s: float | None = None
+
+
+def grasp_events(actions: np.ndarray, layout: ActionLayout = ActionLayout()) -> list[tuple[str, int]]:
+    """Every closing of a gripper (binarised open -> closed) as (arm, step), in time order, left first on ties."""
+    events = []
+    for side, (_, gripper) in layout.arms().items():
+        closed = actions[:, gripper] >= 0
+        events += [(side, int(t)) for t in binarised_events(actions[:, gripper]) if closed[t]]
+    return sorted(events, key=lambda event: (event[1], event[0] != "left"))
+
+
+def galt_per_grasp(actions, fps: float, params: GaltParams = GaltParams(),
+                   layout: ActionLayout = ActionLayout()) -> list[GraspGalt]:
+    """GALT for every grasp of an episode, each measured as the reference measures its final gripper event.
+
+    Unlike the reference, openings are not grasps; episodes shorter than 10 steps have none.
+    """
+    actions = _checked(actions)
+    if len(actions) < MIN_STEPS:
+        return []
+    steps = params.steps(fps)
+    neck = actions[:, list(layout.neck)]
+    neck_speed = channel_speed(neck, fps)
+    hand_speed = {side: channel_speed(actions[:, list(hand)], fps) for side, (hand, _) in layout.arms().items()}
+    return [GraspGalt(side, anchor / fps, _galt_at(anchor, hand_speed[side], fps, params, steps, neck, neck_speed))
+            for side, anchor in grasp_events(actions, layout)]
+
+
+def wrist_lead_per_grasp(actions, fps: float, params: GaltParams = GaltParams(),
+                         layout: ActionLayout = ActionLayout()) -> list[WristLead]:
+    """The wrist-camera analogue of GALT for every grasp (TAVIS-Hands).
+
+    The camera rides on the hand, so its last look before a grasp is the still pose the hand leaves at its
+    reach onset (found as in the reference). The look is the run of steps before the onset where the hand moves
+    slower than 0.05 m/s and turns slower than 0.10 rad/s; its start is refined backwards to where the hand was
+    last more than 0.01 m or 0.05 rad from its pose there. lead_s = (grasp - settle) / fps.
+    """
+    actions = _checked(actions)
+    if len(actions) < MIN_STEPS:
+        return []
+    steps = params.steps(fps)
+    leads = []
+    for side, anchor in grasp_events(actions, layout):
+        position = actions[:, list(layout.arms()[side][0])]
+        quaternion = actions[:, list(layout.orientation(side))]
+        leads.append(_wrist_lead(side, anchor, position, quaternion, fps, params, steps))
+    return leads
+
+
+def _wrist_lead(side, anchor, position, quaternion, fps, params, steps) -> WristLead:
+    t_grasp = anchor / fps
+    move_speed = channel_speed(position, fps)
+    onset = hand_onset(move_speed, anchor, params.v_hand_thresh, steps["m"])
+    if onset is None:
+        return WristLead(side, t_grasp, "no_hand_onset")
+    turn = _angle_between(quaternion[:-1], quaternion[1:]) * fps
+    turn_speed = np.append(turn, turn[-1])  # as channel_speed: forward differences, last value repeated
+    still = (move_speed < params.v_hand_thresh) & (turn_speed < params.v_sac_thresh)
+    start = onset
+    while start > 0 and still[start - 1]:
+        start -= 1
+    if onset - start < steps["k"]:
+        return WristLead(side, t_grasp, "no_fixation", t_hand_onset_s=onset / fps)
+    settle = start
+    while settle > 0 and (np.max(np.abs(position[settle - 1] - position[start])) < params.wrist_arrival_margin_m
+                          and _angle_between(quaternion[settle - 1], quaternion[start]) < params.arrival_margin_rad):
+        settle -= 1
+    lead = (anchor - settle) / fps
+    reason = "outlier_high" if lead > params.outlier_max_s else "ok"
+    return WristLead(side, t_grasp, reason, lead if reason == "ok" else None, settle / fps, onset / fps)
+
+
+def _angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Rotation angle (rad) between unit quaternions, row-wise; q and -q are the same rotation."""
+    q1 = q1 / np.linalg.norm(q1, axis=-1, keepdims=True)
+    q2 = q2 / np.linalg.norm(q2, axis=-1, keepdims=True)
+    return 2.0 * np.arccos(np.clip(np.abs(np.sum(q1 * q2, axis=-1)), 0.0, 1.0))
+
+
+def _checked(actions) -> np.ndarray:
+    actions = np.asarray(actions, dtype=float)
+    if actions.ndim != 2:
+        raise ValueError(f"actions must be a (T, D) array, got shape {actions.shape}")
+    return actions

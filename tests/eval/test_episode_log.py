@@ -7,8 +7,8 @@ import numpy as np
 from lerobot.envs.utils import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd
 
 from lerobot_tavis import canonical
-from lerobot_tavis.eval.episode_log import GALT_FIELDS, EpisodeLogger
-from tests.test_galt import episode
+from lerobot_tavis.eval.episode_log import GALT_FIELDS, WRIST_FIELDS, EpisodeLogger
+from tests.test_galt import episode, peek_then_grasp
 
 
 class ScriptedEnv(gym.Env):
@@ -65,4 +65,14 @@ def test_no_galt_for_failures_or_fixed_camera_modes(tmp_path):
         _run(env, 7, len(actions))
     records = [json.loads(line) for line in log.read_text().splitlines()]
     assert len(records) == 2 and [r["success"] for r in records] == [False, True]
-    assert all(r[field] is None for r in records for field in GALT_FIELDS)
+    assert all(r[field] is None for r in records for field in GALT_FIELDS + WRIST_FIELDS)
+
+
+def test_hands_episodes_log_the_wrist_lead_of_the_final_grasp(tmp_path):
+    actions = peek_then_grasp(20)
+    log = tmp_path / "episodes.jsonl"
+    _run(EpisodeLogger(ScriptedEnv(actions, camera_mode="fixed_wrist"), log, "tavis_hands", 0), 3, len(actions))
+    (record,) = [json.loads(line) for line in log.read_text().splitlines()]
+    assert record["wrist_lead_reason"] == "ok" and record["wrist_lead_arm"] == "right"
+    assert abs(record["wrist_lead_s"] - 1.6) < 0.1
+    assert record["galt_s"] is None  # fixed camera: no GALT

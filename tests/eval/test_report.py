@@ -58,6 +58,21 @@ def test_write_report_writes_tables_and_plots_atomically(tmp_path):
     assert not list(tmp_path.glob(".*partial*"))
 
 
+def test_report_summarises_the_wrist_lead_of_hands_tasks(tmp_path):
+    path = tmp_path / "hands"
+    path.mkdir()
+    records = [{**_record("peeking_box", 0, 1000 + ix, True), "suite": "tavis_hands", "wrist_lead_s": lead,
+                "wrist_lead_reason": "ok" if lead is not None else "no_fixation"}
+               for ix, lead in enumerate([1.0, 2.0, 3.0, None])]
+    (path / "eval_info.json").write_text(json.dumps(
+        {"per_task": [{"task_group": "tavis_hands", "task_id": 0, "metrics": {"successes": [True] * 4}}]}))
+    (path / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    (cell,) = build_report(tmp_path)["cells"]
+    assert cell["wrist_lead_n_valid"] == 3 and cell["wrist_lead_median_s"] == 2.0
+    assert cell["wrist_lead_reasons"] == {"no_fixation": 1, "ok": 3}
+    assert "| peeking_box | id | 2.00 | 1.50 - 2.50 | 3 | no_fixation 1, ok 3 |" in markdown(build_report(tmp_path))
+
+
 def test_missing_or_corrupt_logs_give_clear_errors(tmp_path):
     _eval_dir(tmp_path / "a", "id", {"conditional_pick": [True]})
     (tmp_path / "a" / "episodes.jsonl").write_text('{"suite": "tavis_head"\n')
