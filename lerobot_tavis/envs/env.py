@@ -1,4 +1,5 @@
-"""TavisEnv: one TAVIS task on one robot as a gymnasium env, stepped at 20 Hz.
+"""TavisEnv: one TAVIS task on one robot as a gymnasium env, stepped at 20 Hz (or any divisor of 60 Hz: the
+demonstrators are recorded at 60 Hz, one control tick per step).
 
 The simulator and renderer are built lazily on the first reset, so the env can be constructed in one process and
 used in another (LeRobot's forkserver vector envs). All randomness comes from the generator seeded in
@@ -58,7 +59,7 @@ class TavisEnv(gym.Env):
 
     def __init__(self, task: str = "tabletop", robot: str = "gr1t2", camera_mode: str = "headcam",
                  split: str = "id", image_size: tuple[int, int] = (480, 640), episode_length_s: float = 20.0,
-                 shadows: bool = False, render_mode: str | None = "rgb_array"):
+                 shadows: bool = False, render_mode: str | None = "rgb_array", fps: int = physics.POLICY_HZ):
         info = task_info(task)
         if split not in info.splits:
             raise ValueError(f"split of task {task!r} must be one of {info.splits}, got {split!r}")
@@ -69,6 +70,8 @@ class TavisEnv(gym.Env):
             raise ValueError(f"episode_length_s must be > 0, got {episode_length_s}")
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be 'rgb_array' or None, got {render_mode!r}")
+        if not (isinstance(fps, int) and fps > 0 and physics.CONTROL_HZ % fps == 0):
+            raise ValueError(f"fps must divide the {physics.CONTROL_HZ} Hz control rate (20, 30, 60, ...), got {fps!r}")
 
         self.task = task
         self.task_description = info.prompts[0]
@@ -78,7 +81,10 @@ class TavisEnv(gym.Env):
         self.image_size = (height, width)
         self.shadows = shadows
         self.render_mode = render_mode
-        self._max_episode_steps = int(round(episode_length_s * physics.POLICY_HZ))
+        self.fps = fps
+        self.metadata = {**self.metadata, "render_fps": fps}
+        self._ticks_per_step = physics.CONTROL_HZ // fps
+        self._max_episode_steps = int(round(episode_length_s * fps))
         self._task = make_task(task, "id" if split == "ood_init_pose" else split)
         self._robot = make_robot(robot)
         self._sim: _Sim | None = None
@@ -113,10 +119,10 @@ class TavisEnv(gym.Env):
     def step(self, action):
         sim = self._require_sim()
         applied = sim.controller.set_command(action)
-        for _ in range(physics.TICKS_PER_STEP):
+        for _ in range(self._ticks_per_step):
             sim.advance_tick()
         self._steps += 1
-        self._task.after_step(sim.model, sim.data, self._steps)
+        self._task.after_step(sim.model, sim.data, self._steps / self.fps)
         success = bool(self._task.is_success(sim.data))
         truncated = self._steps >= self._max_episode_steps and not success
         info = {"is_success": success, "applied_action": applied}

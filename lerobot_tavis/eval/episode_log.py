@@ -2,7 +2,7 @@
 
 The wrapper sits inside LeRobot's `FreezeAfterEpisodeEnd`, so it sees each genuine episode once. It records the
 actions the env actually applied (after clipping, and with the neck zeroed in fixed-camera modes) and, when an
-episode ends, computes GALT from them at 20 Hz for successful episodes of head-camera modes, as the reference
+episode ends, computes GALT from them at the env's rate (20 Hz in evaluation) for successful episodes of head-camera modes, as the reference
 does; the GALT fields are also added to that step's `info`. Successful TAVIS-Hands episodes also get the wrist
 analogue of their final grasp (`wrist_lead_*`, any camera mode: it is read from the hand's motion).
 """
@@ -16,7 +16,6 @@ import gymnasium as gym
 import numpy as np
 
 from lerobot_tavis.envs.modes import neck_locked
-from lerobot_tavis.envs.physics import POLICY_HZ
 from lerobot_tavis.metrics.galt import compute_galt, wrist_lead_per_grasp
 
 GALT_FIELDS = ("galt_s", "galt_reason", "galt_arm", "galt_t_head_arrival_s", "galt_t_hand_arrival_s",
@@ -24,19 +23,19 @@ GALT_FIELDS = ("galt_s", "galt_reason", "galt_arm", "galt_t_head_arrival_s", "ga
 WRIST_FIELDS = ("wrist_lead_s", "wrist_lead_reason", "wrist_lead_arm")
 
 
-def galt_fields(actions: np.ndarray | None) -> dict:
+def galt_fields(actions: np.ndarray | None, fps: float) -> dict:
     """GALT of an episode's applied actions as flat log fields (all None when not computed)."""
     if actions is None:
         return dict.fromkeys(GALT_FIELDS)
-    result = compute_galt(actions, fps=POLICY_HZ)
+    result = compute_galt(actions, fps=fps)
     return {"galt_s": result.galt_s, "galt_reason": result.reason, "galt_arm": result.arm,
             "galt_t_head_arrival_s": result.t_head_arrival_s, "galt_t_hand_arrival_s": result.t_hand_arrival_s,
             "galt_t_hand_onset_s": result.t_hand_onset_s, "galt_arm_reach_s": result.arm_reach_s}
 
 
-def wrist_fields(actions: np.ndarray | None) -> dict:
+def wrist_fields(actions: np.ndarray | None, fps: float) -> dict:
     """The wrist analogue of an episode's final grasp as flat log fields (all None when not computed)."""
-    leads = wrist_lead_per_grasp(actions, fps=POLICY_HZ) if actions is not None else []
+    leads = wrist_lead_per_grasp(actions, fps=fps) if actions is not None else []
     if not leads:
         return dict.fromkeys(WRIST_FIELDS)
     final = leads[-1]
@@ -74,7 +73,8 @@ class EpisodeLogger(gym.Wrapper):
             "robot": env.robot_name, "suite": self.suite, "task": env.task, "task_id": self.task_id,
             "split": env.split, "camera_mode": env.camera_mode, "seed": self._seed, "success": success,
             "length_steps": len(self._actions), "prompt": env.task_description,
-            **galt_fields(actions if with_galt else None), **wrist_fields(actions if with_wrist else None),
+            **galt_fields(actions if with_galt else None, env.fps),
+            **wrist_fields(actions if with_wrist else None, env.fps),
         }
 
     def _append(self, record: dict) -> None:

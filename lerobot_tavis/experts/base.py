@@ -1,4 +1,4 @@
-"""The scripted-demonstrator runtime: a behaviour is a generator of timed segments, played at 20 Hz.
+"""The scripted-demonstrator runtime: a behaviour is a generator of timed segments, played at the env's rate.
 
 An expert's `behaviour()` yields segments one at a time; each starts from the action commanded when it starts, so
 a behaviour can look at the (privileged) simulator state between segments to decide what to do next. Segments:
@@ -94,6 +94,7 @@ class Expert(abc.ABC):
     def __init__(self, env, rng: np.random.Generator):
         self.env = env
         self.rng = rng
+        self.dt_s = 1.0 / env.fps
         self.command = canonical.rest_action()
 
     @abc.abstractmethod
@@ -108,12 +109,12 @@ class Expert(abc.ABC):
         self._t = 0.0
 
     def act(self) -> np.ndarray:
-        """The action for the next 1/20 s step."""
+        """The action for the next env step (1 / env.fps seconds)."""
         if self._segment is not None and not self._segment.done(self._t):
-            self._t += DT_S
+            self._t += self.dt_s
         else:
             self._segment = self._next_segment()
-            self._start, self._t = self.command.copy(), DT_S
+            self._start, self._t = self.command.copy(), self.dt_s
         self.command = self._segment.action_at(self._start, self._t)
         return self.command.copy()
 

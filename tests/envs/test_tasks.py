@@ -93,7 +93,7 @@ def test_wait_then_act_layout_and_delay(variant, delays):
     rng = np.random.default_rng(2)
     for _ in range(SEEDS):
         task.initialize_episode(model, data, rng)
-        assert delays[0] <= task.delay_s <= delays[1] and task.green_step == int(task.delay_s * 20)
+        assert delays[0] <= task.delay_s <= delays[1] and task.green_at_s == int(task.delay_s * 20) / 20
         assert task.variant.object_zone.contains(_xy(model, data, task.target))
         assert task.variant.light_zone.contains(data.mocap_pos[model.body("signal_light").mocapid[0]][:2])
         assert _visible(model, data) == [task.target] and not task.is_green
@@ -148,7 +148,7 @@ def test_success_fires_above_the_threshold_and_not_below(task_name):
     task, model, data = _world(task_name, "id")
     task.initialize_episode(model, data, np.random.default_rng(0))
     if task_name == "wait_then_act":
-        task.after_step(model, data, task.green_step)
+        task.after_step(model, data, task.green_at_s)
     if task_name == "multi_shelf_scan":
         inside, outside = (0.50, 0.0, 1.2), (0.40, 0.0, 1.2)
     else:
@@ -169,10 +169,10 @@ def test_wait_then_act_counts_success_only_once_green():
     task.initialize_episode(model, data, np.random.default_rng(0))
     placement.set_free_pose(model, data, task.target, (0.4, 0.0, 1.3))
     mujoco.mj_forward(model, data)
-    task.after_step(model, data, task.green_step - 1)
-    assert not task.is_green and not task.is_success(data)
-    task.after_step(model, data, task.green_step)
-    assert task.is_green and task.is_success(data)
+    task.after_step(model, data, task.green_at_s - 1 / 60)
+    assert not task.is_green and not task.is_success(data) and task.task_state().tolist() == [0.0]
+    task.after_step(model, data, task.green_at_s)
+    assert task.is_green and task.is_success(data) and task.task_state().tolist() == [1.0]
 
 
 def test_blocked_head_camera_is_black_and_the_head_still_moves(small_env):

@@ -15,6 +15,7 @@ class ScriptedEnv(gym.Env):
     """Replays a fixed action trajectory as the 'applied' actions and succeeds on its last step."""
 
     metadata = {"render_fps": 20}
+    fps = 20
     observation_space = gym.spaces.Box(-1, 1, (1,))
     action_space = gym.spaces.Box(-np.inf, np.inf, (19,))
 

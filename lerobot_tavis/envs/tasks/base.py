@@ -2,7 +2,7 @@
 
 Life cycle: `build(spec)` adds the task's props and scenery to the world spec; after compilation `bind(model)`
 resolves ids; every episode `initialize_episode(model, data, rng)` places things (all randomness from `rng`) and
-picks the prompt; after each policy step `after_step(model, data, step)` updates task state (a light, say) and
+picks the prompt; after each env step `after_step(model, data, elapsed_s)` updates task state (a light, say) and
 `is_success(data)` is checked.
 """
 
@@ -46,8 +46,12 @@ class Task(abc.ABC):
     def initialize_episode(self, model: mujoco.MjModel, data: mujoco.MjData, rng: np.random.Generator) -> None:
         """Sample and apply this episode's layout, task state and prompt."""
 
-    def after_step(self, model: mujoco.MjModel, data: mujoco.MjData, step: int) -> None:
-        """Update task state after policy step number `step` (1-based)."""
+    def after_step(self, model: mujoco.MjModel, data: mujoco.MjData, elapsed_s: float) -> None:
+        """Update task state after an env step; `elapsed_s` is the episode time since the first observation."""
+
+    def task_state(self) -> np.ndarray:
+        """Task state that lives outside the simulator state (a light's colour, say), for recordings."""
+        return np.zeros(0)
 
     @abc.abstractmethod
     def is_success(self, data: mujoco.MjData) -> bool:

@@ -43,7 +43,7 @@ class WaitThenAct(YcbTask):
     def __init__(self, variant: str = "id"):
         super().__init__(variant)
         self.delay_s = 0.0
-        self.green_step = 0
+        self.green_at_s = 0.0
         self.is_green = False
 
     def build(self, spec) -> None:
@@ -57,7 +57,7 @@ class WaitThenAct(YcbTask):
     def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
         self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
         self.delay_s = float(rng.uniform(*self.variant.delay_range_s))
-        self.green_step = int(self.delay_s * POLICY_HZ)  # truncation, as the reference
+        self.green_at_s = int(self.delay_s * POLICY_HZ) / POLICY_HZ  # truncated to a 20 Hz step, as the reference
         x, y = self.variant.object_zone.sample(rng)
         placement.place_on_table(model, data, self.target, x, y, rng.uniform(-np.pi, np.pi))
         placement.hide(model, data, [n for n in OBJECT_NAMES if n != self.target])
@@ -65,9 +65,12 @@ class WaitThenAct(YcbTask):
         placement.set_mocap_pose(model, data, LIGHT, (x, y, TABLE_TOP_Z + LIGHT_RADIUS_M))
         self._set_green(model, False)
 
-    def after_step(self, model, data, step: int) -> None:
-        if not self.is_green and step >= self.green_step:
+    def after_step(self, model, data, elapsed_s: float) -> None:
+        if not self.is_green and elapsed_s >= self.green_at_s - 1e-9:
             self._set_green(model, True)
+
+    def task_state(self) -> np.ndarray:
+        return np.array([float(self.is_green)])
 
     def is_success(self, data) -> bool:
         return self.is_green and super().is_success(data)
