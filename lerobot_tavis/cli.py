@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
+
+from lerobot_tavis.errors import TavisError
 
 
 def _demo(args: argparse.Namespace) -> None:
@@ -35,6 +38,50 @@ def _report(args: argparse.Namespace) -> None:
 
     for path in write_report(args.eval_dir):
         print(path)
+
+
+def _record(args: argparse.Namespace) -> None:
+    from lerobot_tavis.dataset_tools.record import RecordConfig, record
+    from lerobot_tavis.envs.config import expand_tasks
+
+    tasks = tuple(t for group in expand_tasks(",".join(args.tasks or [args.suite])).values() for t in group)
+    manifest = record(RecordConfig(out_dir=Path(args.out), robot=args.robot, tasks=tasks,
+                                   episodes_per_task=args.episodes_per_task, split=args.split,
+                                   keep_failures=args.keep_failures, seed_start=args.seed_start,
+                                   workers=args.workers))
+    for task, count in manifest.counts().items():
+        print(f"{task}: {count['kept']} kept, {count['discarded']} discarded")
+
+
+def _convert(args: argparse.Namespace) -> None:
+    if bool(args.raw_dir) == bool(args.from_tavis):
+        raise ValueError("give exactly one of RAW_DIR (a `tavis record` output) and --from-tavis ROOT")
+    image_size = _image_size(args.image_size) if args.image_size else None
+    if args.from_tavis:
+        from lerobot_tavis.dataset_tools.from_tavis import convert_from_tavis
+
+        root = convert_from_tavis(Path(args.from_tavis), args.repo_id, Path(args.root), fps=args.fps,
+                                  image_size=image_size, overwrite=args.overwrite, task=args.task)
+    else:
+        from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+
+        root = convert(ConvertConfig(raw_dir=Path(args.raw_dir), repo_id=args.repo_id, root=Path(args.root),
+                                     fps=args.fps, image_size=image_size or (480, 640), cameras=args.cameras,
+                                     task=args.task, overwrite=args.overwrite))
+    print(root)
+
+
+def _push(args: argparse.Namespace) -> None:
+    from lerobot_tavis.dataset_tools.hub import push_dataset
+
+    print(push_dataset(Path(args.root), args.repo_id, private=args.private, branch=args.branch))
+
+
+def _pull(args: argparse.Namespace) -> None:
+    from lerobot_tavis.dataset_tools.hub import pull_dataset
+
+    dataset = pull_dataset(args.repo_id, root=args.root, revision=args.revision)
+    print(f"{dataset.root}: {dataset.num_episodes} episodes, {dataset.num_frames} frames at {dataset.fps} fps")
 
 
 def _image_size(text: str) -> tuple[int, int]:
@@ -74,6 +121,43 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--out", required=True, help="output directory; finished cells are skipped on re-runs")
     evaluate.set_defaults(run=_eval)
 
+    rec = commands.add_parser("record", help="record scripted demonstrations at 60 Hz (replayable raw episodes)")
+    rec.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
+    rec.add_argument("--suite", default="tavis_head", choices=["tavis_head", "tavis_hands"])
+    rec.add_argument("--tasks", nargs="+", help="task names (default: every task of --suite)")
+    rec.add_argument("--split", default="id", choices=["id", "ood_spatial", "ood_init_pose"])
+    rec.add_argument("--episodes-per-task", type=int, default=160, help="kept episodes per task (default 160)")
+    rec.add_argument("--keep-failures", action="store_true", help="keep failed episodes too (default: discard)")
+    rec.add_argument("--seed-start", type=int, default=100_000, help="first seed (evaluation uses 1000..)")
+    rec.add_argument("--workers", type=int, default=1, help="parallel processes")
+    rec.add_argument("--out", required=True, help="raw directory; re-running resumes it")
+    rec.set_defaults(run=_record)
+
+    conv = commands.add_parser("convert", help="raw episodes (or an original TAVIS dataset) -> LeRobotDataset v3.0")
+    conv.add_argument("raw_dir", nargs="?", help="a `tavis record` output directory")
+    conv.add_argument("--from-tavis", metavar="ROOT", help="convert an original TAVIS dataset (60 Hz) instead")
+    conv.add_argument("--repo-id", required=True, help="dataset id, e.g. <user>/tavis-head-gr1t2")
+    conv.add_argument("--root", required=True, help="destination directory (must not exist unless --overwrite)")
+    conv.add_argument("--fps", type=int, default=20, help="dataset rate; must divide 60 (default 20)")
+    conv.add_argument("--image-size", help="HxW of every camera (default 480x640; --from-tavis: the source size)")
+    conv.add_argument("--cameras", default="head,fixed,left_wrist,right_wrist", help="comma list of cameras")
+    conv.add_argument("--task", help="convert only this task")
+    conv.add_argument("--overwrite", action="store_true", help="replace an existing destination")
+    conv.set_defaults(run=_convert)
+
+    push = commands.add_parser("push", help="upload a converted dataset to the Hugging Face Hub, with its card")
+    push.add_argument("root", help="the dataset directory (a `tavis convert` output)")
+    push.add_argument("--repo-id", required=True, help="<user>/<name> on the Hub")
+    push.add_argument("--private", action="store_true")
+    push.add_argument("--branch", help="push to this branch (default: main)")
+    push.set_defaults(run=_push)
+
+    pull = commands.add_parser("pull", help="download a TAVIS dataset from the Hugging Face Hub")
+    pull.add_argument("repo_id", help="<user>/<name> on the Hub")
+    pull.add_argument("--root", help="where to put it (default: LeRobot's cache)")
+    pull.add_argument("--revision", help="branch, tag or commit")
+    pull.set_defaults(run=_pull)
+
     report = commands.add_parser("report", help="success rates with Wilson CIs, GALT, plots from eval outputs")
     report.add_argument("eval_dir", help="directory holding lerobot-eval outputs (eval_info.json, episodes.jsonl)")
     report.set_defaults(run=_report)
@@ -84,7 +168,7 @@ def main(argv: list[str] | None = None) -> None:
     args = build_parser().parse_args(argv)
     try:
         args.run(args)
-    except (ValueError, FileExistsError, FileNotFoundError) as error:
+    except (ValueError, FileExistsError, FileNotFoundError, TavisError) as error:
         sys.exit(f"tavis {args.command}: error: {error}")
 
 

@@ -12,9 +12,8 @@ import numpy as np
 from tqdm import tqdm
 
 from lerobot_tavis.envs.env import TavisEnv
-from lerobot_tavis.envs.rendering import CameraRig
+from lerobot_tavis.envs.modes import CAMERA_NAMES
 from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
-from lerobot_tavis.envs.world import CAMERA_NAMES
 from lerobot_tavis.experts.registry import make_expert
 from lerobot_tavis.media import side_by_side, write_mp4
 
@@ -24,21 +23,18 @@ TASKS = tuple(task for suite in SUITES for task in suite_tasks(suite))
 
 def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) -> tuple[list[np.ndarray], bool]:
     """Frames (four labelled views side by side) of one demonstrator episode, and whether it succeeded."""
-    env = TavisEnv(task, robot, camera_mode="head_wrist", image_size=image_size)
-    env.reset(seed=seed)
-    rig = CameraRig(env.model, {name: env.world.cameras[name] for name in CAMERA_NAMES}, image_size,
-                    blacked_out=env.task_object.blacked_out_cameras)
+    env = TavisEnv(task, robot, camera_mode="head_wrist", image_size=image_size, cameras=CAMERA_NAMES)
+    obs, _ = env.reset(seed=seed)
     expert = make_expert(env, seed)
     expert.reset()
-    frames, success = [side_by_side(rig.render(env.data))], False
+    frames, success = [side_by_side(obs["pixels"])], False
     for _ in range(env._max_episode_steps):
-        _, _, terminated, truncated, info = env.step(expert.act())
-        frames.append(side_by_side(rig.render(env.data)))
+        obs, _, terminated, truncated, info = env.step(expert.act())
+        frames.append(side_by_side(obs["pixels"]))
         success = info["is_success"]
         if terminated or truncated:
             break
     frames += frames[-1:] * FPS  # one more second on the final frame
-    rig.close()
     env.close()
     return frames, success
 

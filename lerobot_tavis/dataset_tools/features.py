@@ -15,8 +15,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from lerobot_tavis import canonical
-
-CAMERAS = ("head", "fixed", "left_wrist", "right_wrist")
+from lerobot_tavis.envs.modes import CAMERA_NAMES as CAMERAS
 STATE_KEY = "observation.state"
 JOINT_POS_KEY = "observation.joint_pos"
 ACTION_KEY = "action"

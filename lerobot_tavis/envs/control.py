@@ -137,7 +137,9 @@ class Controller:
             command[canonical.HEAD] = 0.0
         for arm in canonical.ARMS:
             command[arm.gripper] = np.clip(command[arm.gripper], -1.0, 1.0)
-            command[arm.quaternion] /= np.linalg.norm(command[arm.quaternion])
+            norm = np.linalg.norm(command[arm.quaternion])
+            if abs(norm - 1.0) > 1e-12:  # so that applying an applied command again changes nothing, not a bit
+                command[arm.quaternion] /= norm
         self.command = command
         self.ik.set_targets(hand_targets(self.robot, command))
         return command

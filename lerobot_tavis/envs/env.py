@@ -17,7 +17,7 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.control import Controller
-from lerobot_tavis.envs.modes import mode_cameras, neck_locked
+from lerobot_tavis.envs.modes import CAMERA_NAMES, mode_cameras, neck_locked
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
@@ -36,12 +36,12 @@ WARM_UP_HEAD_STD_RAD = 0.175
 class _Sim:
     """Model, data, controller and renderer of one env; exists between the first reset and close()."""
 
-    def __init__(self, world: World, camera_mode: str, image_size, blacked_out):
+    def __init__(self, world: World, camera_mode: str, camera_names, image_size, blacked_out):
         self.world = world
         self.model = world.model
         self.data = mujoco.MjData(world.model)
         self.controller = Controller(world, neck_locked=neck_locked(camera_mode))
-        cameras = {name: world.cameras[name] for name in mode_cameras(camera_mode)}
+        cameras = {name: world.cameras[name] for name in camera_names}
         self.rig = CameraRig(world.model, cameras, image_size, blacked_out)
 
     def advance_tick(self) -> None:
@@ -53,17 +53,21 @@ class TavisEnv(gym.Env):
     """A TAVIS task. Observations: `pixels` (the camera mode's cameras, HxWx3 uint8), `agent_pos` (the measured
     canonical 19-D state) and `joint_pos` (robot joints, see `Robot.joint_names`). Actions: the canonical 19-D
     action (`lerobot_tavis.canonical`); head angles and gripper values outside their ranges are clipped.
+
+    `cameras` overrides which cameras the observations carry (default: the camera mode's); `()` renders nothing,
+    for recording and replay, which render what they need themselves.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": physics.POLICY_HZ}
 
     def __init__(self, task: str = "tabletop", robot: str = "gr1t2", camera_mode: str = "headcam",
                  split: str = "id", image_size: tuple[int, int] = (480, 640), episode_length_s: float = 20.0,
-                 shadows: bool = False, render_mode: str | None = "rgb_array", fps: int = physics.POLICY_HZ):
+                 shadows: bool = False, render_mode: str | None = "rgb_array", fps: int = physics.POLICY_HZ,
+                 cameras: tuple[str, ...] | None = None):
         info = task_info(task)
         if split not in info.splits:
             raise ValueError(f"split of task {task!r} must be one of {info.splits}, got {split!r}")
-        self.camera_names = mode_cameras(camera_mode)
+        self.camera_names = mode_cameras(camera_mode) if cameras is None else _check_cameras(cameras)
         make_robot(robot)  # validates the name; the model itself is built on the first reset
         height, width = _check_image_size(image_size)
         if not episode_length_s > 0:
@@ -132,6 +136,8 @@ class TavisEnv(gym.Env):
         """The last observation's camera images side by side, without rendering again."""
         if self._last_frames is None:
             raise RuntimeError("render() needs an observation: call reset() first")
+        if not self.camera_names:
+            raise RuntimeError("this env renders no cameras (it was made with cameras=())")
         return np.concatenate([self._last_frames[name] for name in self.camera_names], axis=1)
 
     def close(self) -> None:
@@ -164,7 +170,8 @@ class TavisEnv(gym.Env):
     def _ensure_sim(self) -> _Sim:
         if self._sim is None:
             world = build_world(self._robot, self._task, image_size=self.image_size, shadows=self.shadows)
-            self._sim = _Sim(world, self.camera_mode, self.image_size, self._task.blacked_out_cameras)
+            self._sim = _Sim(world, self.camera_mode, self.camera_names, self.image_size,
+                             self._task.blacked_out_cameras)
         return self._sim
 
     def _require_sim(self) -> _Sim:
@@ -211,6 +218,13 @@ def warm_up_action(rng: np.random.Generator) -> np.ndarray:
         action[arm.position] += rng.normal(0.0, WARM_UP_POSITION_STD_M, size=3)
     action[[canonical.HEAD_PITCH, canonical.HEAD_YAW]] += rng.normal(0.0, WARM_UP_HEAD_STD_RAD, size=2)
     return action
+
+
+def _check_cameras(cameras) -> tuple[str, ...]:
+    cameras = tuple(cameras)
+    if not set(cameras) <= set(CAMERA_NAMES) or len(set(cameras)) != len(cameras):
+        raise ValueError(f"cameras must be distinct names among {CAMERA_NAMES}, got {cameras!r}")
+    return cameras
 
 
 def _check_image_size(image_size) -> tuple[int, int]:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+CAMERA_NAMES = ("head", "fixed", "left_wrist", "right_wrist")
+
 CAMERA_MODES: dict[str, tuple[str, ...]] = {
     "headcam": ("head",),
     "fixedcam": ("fixed",),

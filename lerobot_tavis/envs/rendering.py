@@ -16,6 +16,9 @@ class CameraRig:
         self.height, self.width = image_size
         self.cameras = cameras
         self.blacked_out = blacked_out
+        self._renderer = None
+        if not set(cameras) - set(blacked_out):
+            return  # nothing to draw: no GL context needed
         try:
             self._renderer = mujoco.Renderer(model, height=self.height, width=self.width)
         except mujoco.FatalError as error:
@@ -37,4 +40,5 @@ class CameraRig:
         return frames
 
     def close(self) -> None:
-        self._renderer.close()
+        if self._renderer is not None:
+            self._renderer.close()

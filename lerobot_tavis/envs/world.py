@@ -8,10 +8,10 @@ import mujoco
 import numpy as np
 
 from lerobot_tavis.envs import physics, scene
+from lerobot_tavis.envs.modes import CAMERA_NAMES
 from lerobot_tavis.envs.robots import Robot
 from lerobot_tavis.envs.tasks.base import Task
 
-CAMERA_NAMES = ("head", "fixed", "left_wrist", "right_wrist")
 
 
 @dataclass(frozen=True)

@@ -2,9 +2,10 @@
 
 The wrapper sits inside LeRobot's `FreezeAfterEpisodeEnd`, so it sees each genuine episode once. It records the
 actions the env actually applied (after clipping, and with the neck zeroed in fixed-camera modes) and, when an
-episode ends, computes GALT from them at the env's rate (20 Hz in evaluation) for successful episodes of head-camera modes, as the reference
-does; the GALT fields are also added to that step's `info`. Successful TAVIS-Hands episodes also get the wrist
-analogue of their final grasp (`wrist_lead_*`, any camera mode: it is read from the hand's motion).
+episode ends, computes GALT from them at the env's rate (20 Hz in evaluation) for successful episodes of
+head-camera modes, as the reference does; the GALT fields are also added to that step's `info`. Successful
+TAVIS-Hands episodes also get the wrist analogue of their final grasp (`wrist_lead_*`, any camera mode: it is
+read from the hand's motion).
 """
 
 from __future__ import annotations

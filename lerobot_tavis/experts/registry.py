@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,16 +39,21 @@ class EpisodeResult:
     actions: np.ndarray  # (T, 19) applied actions
 
 
-def run_episode(env, seed: int, expert: Expert | None = None) -> EpisodeResult:
+def run_episode(env, seed: int, expert: Expert | None = None,
+                on_step: Callable[[], None] | None = None) -> EpisodeResult:
     """Reset `env` (a TavisEnv, possibly wrapped) with `seed` and let its demonstrator act until the episode
-    ends."""
+    ends. `on_step` is called after the reset and after every step (to record the simulator state, say)."""
     env.reset(seed=seed)
     expert = expert or make_expert(env.unwrapped, seed)
     expert.reset()
     actions, info = [], {"is_success": False}
+    if on_step:
+        on_step()
     for _ in range(env.unwrapped._max_episode_steps):
         _, _, terminated, truncated, info = env.step(expert.act())
         actions.append(info["applied_action"])
+        if on_step:
+            on_step()
         if terminated or truncated:
             break
     return EpisodeResult(bool(info["is_success"]), len(actions), np.array(actions))

@@ -1,0 +1,157 @@
+"""`tavis convert`: replay raw episodes, render the cameras and write a LeRobotDataset v3.0.
+
+Each raw episode is replayed from its seed with its recorded 60 Hz actions. Every (60 / fps)-th step becomes a
+frame: the observation at that step (images, measured canonical state, joint positions) with the action taken from
+it. The replay must end as the recording did (success and length), else the conversion stops with an error; the
+largest joint-state deviation from the recorded states is kept per episode in `meta/tavis_conversion.json`.
+The dataset is written beside its destination and moved into place only when complete.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from lerobot_tavis.dataset_tools import features as ft
+from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
+from lerobot_tavis.dataset_tools.staging import staged_directory
+from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
+from lerobot_tavis.errors import TavisError
+
+CONVERSION_LOG = "meta/tavis_conversion.json"
+
+
+class ReplayError(TavisError):
+    """A replay did not reproduce its recording."""
+
+
+@dataclass(frozen=True)
+class ConvertConfig:
+    raw_dir: Path
+    repo_id: str
+    root: Path
+    fps: int = 20
+    image_size: tuple[int, int] = (480, 640)
+    cameras: tuple[str, ...] = ft.CAMERAS
+    task: str | None = None
+    overwrite: bool = False
+
+
+def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
+    """Convert `cfg.raw_dir` into a LeRobotDataset at `cfg.root`; returns the root."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    from lerobot_tavis.envs.robots import make_robot
+
+    cameras = ft.parse_cameras(cfg.cameras)
+    manifest = Manifest.load(cfg.raw_dir)
+    stride = _stride(manifest.fps, cfg.fps)
+    order = [task for suite in SUITES for task in suite_tasks(suite)]
+    entries = sorted((e for e in manifest.episodes if cfg.task in (None, e.task)),
+                     key=lambda e: (order.index(e.task) if e.task in order else len(order), e.task, e.seed))
+    if not entries:
+        raise ValueError(f"{cfg.raw_dir} holds no episodes" + (f" of task {cfg.task!r}" if cfg.task else ""))
+    damaged = manifest.damaged(cfg.raw_dir)
+    if damaged:
+        listing = ", ".join(f"{file} ({problem})" for file, problem in damaged.items())
+        raise RawEpisodeError(f"{cfg.raw_dir}: damaged raw episodes, nothing converted: {listing}")
+    features = ft.dataset_features(make_robot(manifest.robot).joint_names(), cameras, cfg.image_size)
+    deviations = {}
+    with staged_directory(cfg.root, overwrite=cfg.overwrite) as staging:
+        dataset = LeRobotDataset.create(cfg.repo_id, fps=cfg.fps, features=features, root=staging,
+                                        robot_type=manifest.robot, use_videos=True, video_backend="pyav")
+        replayer = Replayer(cameras, cfg.image_size, stride)
+        try:
+            for entry in tqdm(entries, desc=f"convert {cfg.repo_id}", unit="ep", disable=not progress):
+                episode = load_episode(Path(cfg.raw_dir) / entry.file, entry.sha256)
+                for frame in replayer.frames(episode):
+                    dataset.add_frame(frame)
+                dataset.save_episode()
+                deviations[entry.file] = replayer.max_deviation
+        finally:
+            replayer.close()
+            dataset.finalize()  # also on failure: an unfinalized dataset writes into the staging folder later
+        log = {"raw_dir": str(Path(cfg.raw_dir).absolute()), "fps": cfg.fps, "stride": stride,
+               "image_size": list(cfg.image_size), "cameras": list(cameras),
+               "episodes": [{"episode_index": i, "raw_file": e.file, "task": e.task, "seed": e.seed,
+                             "max_qpos_deviation": deviations[e.file]} for i, e in enumerate(entries)]}
+        (staging / CONVERSION_LOG).write_text(json.dumps(log, indent=1) + "\n")
+    return Path(cfg.root)
+
+
+def _stride(raw_fps: int, fps: int) -> int:
+    if fps < 1 or raw_fps % fps:
+        raise ValueError(f"fps must divide the recording rate of {raw_fps} Hz (20, 30, 60, ...), got {fps}")
+    return raw_fps // fps
+
+
+class Replayer:
+    """Replays raw episodes in one env per task, rendering `cameras` at every `stride`-th step."""
+
+    def __init__(self, cameras: Sequence[str], image_size: tuple[int, int], stride: int):
+        self.cameras = tuple(cameras)
+        self.image_size = image_size
+        self.stride = stride
+        self.max_deviation = 0.0
+        self._envs: dict[tuple[str, str, str], tuple] = {}  # (robot, task, split) -> (env, camera rig)
+
+    def frames(self, episode: RawEpisode) -> Iterator[dict]:
+        """The LeRobot frames of one episode, replaying it; raises ReplayError if it does not end as recorded."""
+        env, rig = self._env(episode)
+        obs, _ = env.reset(seed=episode.seed)
+        if env.task_description != episode.prompt:
+            raise ReplayError(f"{episode.task} seed {episode.seed}: the replay's prompt {env.task_description!r} "
+                              f"differs from the recorded {episode.prompt!r}")
+        self.max_deviation = float(np.max(np.abs(env.data.qpos - episode.qpos[0])))
+        info, ended_at = {"is_success": False}, None
+        for step, action in enumerate(episode.actions):
+            if ended_at is not None:
+                break
+            if step % self.stride == 0:
+                yield self._frame(episode, rig.render(env.data), obs, action)
+            obs, _, terminated, truncated, info = env.step(action)
+            self.max_deviation = max(self.max_deviation, float(np.max(np.abs(env.data.qpos - episode.qpos[step + 1]))))
+            if terminated or truncated:
+                ended_at = step + 1
+        if (bool(info["is_success"]), ended_at or episode.n_steps) != (episode.success, episode.n_steps):
+            raise ReplayError(
+                f"{episode.task} seed {episode.seed}: the replay ended with success={info['is_success']} after "
+                f"{ended_at or episode.n_steps} steps, the recording with success={episode.success} after "
+                f"{episode.n_steps} (largest joint-state deviation {self.max_deviation:.3g})")
+
+    def _frame(self, episode: RawEpisode, images: dict, obs: dict, action: np.ndarray) -> dict:
+        frame = {ft.image_key(camera): image for camera, image in images.items()}
+        frame[ft.STATE_KEY] = obs["agent_pos"].astype(np.float32)
+        frame[ft.JOINT_POS_KEY] = obs["joint_pos"].astype(np.float32)
+        frame[ft.ACTION_KEY] = np.asarray(action, dtype=np.float32)
+        frame[ft.TASK_NAME_KEY] = episode.task
+        frame[ft.SPLIT_KEY] = episode.split
+        frame["task"] = episode.prompt
+        return frame
+
+    def _env(self, episode: RawEpisode):
+        """The env of the episode's robot, task and split (rendering nothing itself) and a rig for the cameras."""
+        from lerobot_tavis.envs.env import TavisEnv
+        from lerobot_tavis.envs.rendering import CameraRig
+
+        key = (episode.robot, episode.task, episode.split)
+        if key not in self._envs:
+            env = TavisEnv(episode.task, episode.robot, split=episode.split, fps=episode.fps,
+                           image_size=self.image_size, cameras=())
+            env.reset(seed=episode.seed)  # builds the simulator
+            rig = CameraRig(env.model, {name: env.world.cameras[name] for name in self.cameras}, self.image_size,
+                            env.task_object.blacked_out_cameras)
+            self._envs[key] = env, rig
+        return self._envs[key]
+
+    def close(self) -> None:
+        for env, rig in self._envs.values():
+            rig.close()
+            env.close()

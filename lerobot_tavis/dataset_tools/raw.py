@@ -1,0 +1,179 @@
+"""Raw demonstrations: one compressed `.npz` per episode (no pickle) and a `manifest.json` with checksums.
+
+A raw episode holds what replays it exactly: robot, task, split, seed and prompt, the actions the env applied at
+the recording rate (60 Hz), and the simulator state after the reset and after every step (`qpos`, `qvel`, and the
+task state that lives outside the simulator, such as the light colour), to check a replay against. No images.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import zipfile
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from lerobot_tavis import canonical
+from lerobot_tavis.errors import TavisError
+
+FORMAT = "tavis-raw"
+FORMAT_VERSION = 1
+MANIFEST_NAME = "manifest.json"
+ARRAYS = ("actions", "qpos", "qvel", "task_state")
+
+
+class RawEpisodeError(TavisError, ValueError):
+    """A raw episode file or the manifest is missing, corrupt, or does not match the recording."""
+
+
+@dataclass
+class RawEpisode:
+    robot: str
+    task: str
+    split: str
+    seed: int
+    prompt: str
+    fps: int
+    success: bool
+    actions: np.ndarray  # (T, 19) canonical actions as applied, float64
+    qpos: np.ndarray  # (T + 1, nq): after the reset, then after each step
+    qvel: np.ndarray  # (T + 1, nv)
+    task_state: np.ndarray  # (T + 1, k)
+
+    @property
+    def n_steps(self) -> int:
+        return len(self.actions)
+
+    def metadata(self) -> dict:
+        return {"format": FORMAT, "version": FORMAT_VERSION, "robot": self.robot, "task": self.task,
+                "split": self.split, "seed": self.seed, "prompt": self.prompt, "fps": self.fps,
+                "success": self.success}
+
+
+def episode_filename(task: str, seed: int) -> str:
+    return f"{task}/seed_{seed:08d}.npz"
+
+
+def save_episode(path: str | Path, episode: RawEpisode) -> str:
+    """Write `episode` to `path` atomically; returns the file's SHA-256."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f".{path.name}.partial")
+    with open(partial, "wb") as file:
+        np.savez_compressed(file, metadata=np.array(json.dumps(episode.metadata())),
+                            **{name: getattr(episode, name) for name in ARRAYS})
+    os.replace(partial, path)
+    return file_sha256(path)
+
+
+def load_episode(path: str | Path, sha256: str | None = None) -> RawEpisode:
+    """Read a raw episode, checking its checksum when given; any damage raises RawEpisodeError naming the file."""
+    path = Path(path)
+    if not path.is_file():
+        raise RawEpisodeError(f"{path}: raw episode file is missing")
+    if sha256 is not None and file_sha256(path) != sha256:
+        raise RawEpisodeError(f"{path}: checksum does not match the manifest (the file is corrupt or was changed)")
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            metadata = json.loads(str(archive["metadata"]))
+            arrays = {name: np.array(archive[name]) for name in ARRAYS}
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as error:
+        raise RawEpisodeError(f"{path}: not a readable raw episode ({type(error).__name__}: {error})") from None
+    if metadata.get("format") != FORMAT or metadata.get("version") != FORMAT_VERSION:
+        raise RawEpisodeError(f"{path}: not a {FORMAT} v{FORMAT_VERSION} file")
+    episode = RawEpisode(**{k: v for k, v in metadata.items() if k not in ("format", "version")}, **arrays)
+    _check_shapes(path, episode)
+    return episode
+
+
+def _check_shapes(path: Path, episode: RawEpisode) -> None:
+    steps = episode.n_steps
+    if episode.actions.ndim != 2 or episode.actions.shape[1] != canonical.ACTION_DIM or steps == 0:
+        raise RawEpisodeError(f"{path}: actions must be (T, {canonical.ACTION_DIM}) with T > 0, "
+                              f"got {episode.actions.shape}")
+    for name in ("qpos", "qvel", "task_state"):
+        rows = len(getattr(episode, name))
+        if rows != steps + 1:
+            raise RawEpisodeError(f"{path}: {name} must have {steps + 1} rows (T + 1), got {rows}")
+
+
+def file_sha256(path: str | Path) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as file:
+        for block in iter(lambda: file.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+@dataclass
+class ManifestEntry:
+    task: str
+    seed: int
+    success: bool
+    n_steps: int
+    file: str | None = None  # relative to the raw directory; None for a discarded episode
+    sha256: str | None = None
+
+
+@dataclass
+class Manifest:
+    """What a raw directory holds: kept episodes with checksums, and the seeds tried and discarded."""
+
+    robot: str
+    split: str
+    fps: int
+    seed_start: int
+    episodes: list[ManifestEntry] = field(default_factory=list)
+    discarded: list[ManifestEntry] = field(default_factory=list)
+
+    def add(self, entry: ManifestEntry) -> None:
+        (self.episodes if entry.file else self.discarded).append(entry)
+
+    def tried_seeds(self, task: str) -> set[int]:
+        return {e.seed for e in self.episodes + self.discarded if e.task == task}
+
+    def kept(self, task: str) -> int:
+        return sum(e.task == task for e in self.episodes)
+
+    def counts(self) -> dict[str, dict[str, int]]:
+        tasks = dict.fromkeys(e.task for e in self.episodes + self.discarded)
+        return {task: {"kept": self.kept(task), "discarded": sum(e.task == task for e in self.discarded)}
+                for task in tasks}
+
+    def save(self, raw_dir: str | Path) -> None:
+        path = Path(raw_dir) / MANIFEST_NAME
+        partial = path.with_name(f".{path.name}.partial")
+        document = {"format": FORMAT, "version": FORMAT_VERSION, "robot": self.robot, "split": self.split,
+                    "fps": self.fps, "seed_start": self.seed_start, "counts": self.counts(),
+                    "episodes": [asdict(e) for e in self.episodes],
+                    "discarded": [asdict(e) for e in self.discarded]}
+        partial.write_text(json.dumps(document, indent=1) + "\n")
+        os.replace(partial, path)
+
+    @classmethod
+    def load(cls, raw_dir: str | Path) -> Manifest:
+        path = Path(raw_dir) / MANIFEST_NAME
+        if not path.is_file():
+            raise FileNotFoundError(f"{path} not found: is {raw_dir} a directory written by `tavis record`?")
+        try:
+            document = json.loads(path.read_text())
+            return cls(robot=document["robot"], split=document["split"], fps=int(document["fps"]),
+                       seed_start=int(document["seed_start"]),
+                       episodes=[ManifestEntry(**e) for e in document["episodes"]],
+                       discarded=[ManifestEntry(**e) for e in document["discarded"]])
+        except (ValueError, KeyError, TypeError) as error:
+            raise RawEpisodeError(f"{path}: not a valid manifest ({type(error).__name__}: {error})") from None
+
+    def damaged(self, raw_dir: str | Path) -> dict[str, str]:
+        """Kept episodes whose file is missing or fails its checksum: {file: problem}."""
+        problems = {}
+        for entry in self.episodes:
+            path = Path(raw_dir) / entry.file
+            if not path.is_file():
+                problems[entry.file] = "missing"
+            elif file_sha256(path) != entry.sha256:
+                problems[entry.file] = "checksum mismatch"
+        return problems

@@ -1,0 +1,187 @@
+"""`tavis record` and `tavis convert`: raw episodes that replay exactly, and the LeRobotDataset made from them."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from lerobot_tavis import canonical
+from lerobot_tavis.cli import main
+from lerobot_tavis.dataset_tools import raw as raw_files
+from lerobot_tavis.dataset_tools import record as recorder
+from lerobot_tavis.dataset_tools.convert import ConvertConfig, ReplayError, convert
+from lerobot_tavis.dataset_tools.features import ACTION_KEY, JOINT_POS_KEY, STATE_KEY, image_key
+from lerobot_tavis.envs.robots import make_robot
+from lerobot_tavis.envs.tasks.catalog import suite_tasks
+
+HANDS = suite_tasks("tavis_hands")
+IMAGE_SIZE = (48, 64)
+
+
+@pytest.fixture(scope="module")
+def raw_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("raw")
+    main(["record", "--robot", "gr1t2", "--suite", "tavis_hands", "--episodes-per-task", "2", "--out", str(out)])
+    return out
+
+
+@pytest.fixture(scope="module")
+def dataset(raw_dir, tmp_path_factory):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    root = tmp_path_factory.mktemp("converted") / "hands"
+    main(["convert", str(raw_dir), "--repo-id", "local/tavis-hands-gr1t2", "--root", str(root), "--fps", "20",
+          "--image-size", "48x64", "--cameras", "head,fixed,left_wrist,right_wrist"])
+    return LeRobotDataset("local/tavis-hands-gr1t2", root=root, video_backend="pyav")
+
+
+def _copy_raw(raw_dir, tmp_path):
+    import shutil
+
+    return shutil.copytree(raw_dir, tmp_path / "raw")
+
+
+def test_record_keeps_two_replayable_episodes_per_task(raw_dir):
+    manifest = raw_files.Manifest.load(raw_dir)
+    assert {task: count["kept"] for task, count in manifest.counts().items()} == dict.fromkeys(HANDS, 2)
+    assert manifest.fps == 60 and manifest.robot == "gr1t2"
+    assert not manifest.damaged(raw_dir)
+    entry = manifest.episodes[0]
+    episode = raw_files.load_episode(raw_dir / entry.file, entry.sha256)
+    assert episode.success and episode.seed >= 100_000 and episode.fps == 60
+    assert episode.actions.shape == (entry.n_steps, 19) and len(episode.qpos) == entry.n_steps + 1
+
+
+def test_record_resumes_without_recording_finished_episodes(raw_dir, monkeypatch):
+    def refuse(*args):
+        raise AssertionError(f"re-recorded {args}")
+
+    monkeypatch.setattr(recorder, "record_episode", refuse)
+    before = (raw_dir / "manifest.json").read_text()
+    main(["record", "--robot", "gr1t2", "--suite", "tavis_hands", "--episodes-per-task", "2", "--out", str(raw_dir)])
+    assert (raw_dir / "manifest.json").read_text() == before
+
+
+def test_record_re_records_a_damaged_episode_identically(raw_dir, tmp_path, capsys):
+    raw = _copy_raw(raw_dir, tmp_path)
+    entry = raw_files.Manifest.load(raw).episodes[0]
+    (raw / entry.file).write_bytes(b"truncated")
+    main(["record", "--robot", "gr1t2", "--suite", "tavis_hands", "--episodes-per-task", "2", "--out", str(raw)])
+    assert f"{entry.file}: checksum mismatch" in capsys.readouterr().err
+    assert raw_files.file_sha256(raw / entry.file) == entry.sha256  # same seed, same episode, same bytes
+
+
+def test_record_refuses_a_directory_of_another_robot(raw_dir):
+    with pytest.raises(SystemExit, match="robot/split/seed_start"):
+        main(["record", "--robot", "reachy2", "--suite", "tavis_hands", "--episodes-per-task", "2",
+              "--out", str(raw_dir)])
+
+
+def test_converted_dataset_features_names_and_counts(dataset, raw_dir):
+    manifest = raw_files.Manifest.load(raw_dir)
+    assert dataset.fps == 20 and dataset.num_episodes == len(manifest.episodes) == 6
+    features = dataset.meta.features
+    for camera in ("head", "fixed", "left_wrist", "right_wrist"):
+        assert features[image_key(camera)]["dtype"] == "video"
+        assert tuple(features[image_key(camera)]["shape"]) == (*IMAGE_SIZE, 3)
+    assert features[STATE_KEY]["names"] == list(canonical.ACTION_NAMES)
+    assert features[ACTION_KEY]["names"] == list(canonical.ACTION_NAMES)
+    assert features[JOINT_POS_KEY]["names"] == list(make_robot("gr1t2").joint_names())
+    lengths = {row["episode_index"]: row["length"] for row in dataset.meta.episodes}
+    episodes = _episodes_in_dataset_order(manifest)
+    assert [lengths[i] for i in range(6)] == [-(-e.n_steps // 3) for e in episodes]  # ceil(T / 3)
+
+
+def _episodes_in_dataset_order(manifest):
+    return sorted(manifest.episodes, key=lambda e: (HANDS.index(e.task), e.seed))
+
+
+def test_frames_pair_each_observation_with_the_recorded_action(dataset, raw_dir):
+    episodes = _episodes_in_dataset_order(raw_files.Manifest.load(raw_dir))
+    start = 0
+    for index, entry in enumerate(episodes):
+        episode = raw_files.load_episode(raw_dir / entry.file)
+        for j in (0, 7):
+            frame = dataset[start + j]
+            assert int(frame["episode_index"]) == index and int(frame["frame_index"]) == j
+            np.testing.assert_array_equal(frame[ACTION_KEY].numpy(), episode.actions[3 * j].astype(np.float32))
+            assert frame["task"] == episode.prompt and frame["task_name"] == entry.task and frame["split"] == "id"
+        start += -(-entry.n_steps // 3)
+    first = dataset[0]
+    assert first[image_key("head")].shape == (3, *IMAGE_SIZE)
+    blocked = HANDS.index("blocked_clutter_pick_cube") * 2
+    blocked_start = sum(-(-e.n_steps // 3) for e in episodes[:blocked])
+    assert float(dataset[blocked_start][image_key("head")].max()) < 0.05  # the head camera is black there
+    log = json.loads((dataset.root / "meta" / "tavis_conversion.json").read_text())
+    assert [e["max_qpos_deviation"] for e in log["episodes"]] == [0.0] * 6  # exact replay
+
+
+def test_converting_twice_gives_identical_data(raw_dir, tmp_path):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    roots = []
+    for name in ("a", "b"):
+        cfg = ConvertConfig(raw_dir, f"local/{name}", tmp_path / name, image_size=IMAGE_SIZE, task="peeking_box")
+        roots.append(convert(cfg, progress=False))
+    tables = [pd.read_parquet(root / "data") for root in roots]
+    pd.testing.assert_frame_equal(*tables)
+    first, second = (LeRobotDataset(f"local/{n}", root=r, video_backend="pyav") for n, r in zip("ab", roots))
+    for index in (0, len(first) - 1):
+        for camera in ("head", "left_wrist"):
+            assert np.array_equal(first[index][image_key(camera)].numpy(), second[index][image_key(camera)].numpy())
+
+
+def test_a_corrupt_raw_file_gives_a_clear_error_and_writes_nothing(raw_dir, tmp_path, capsys):
+    raw = _copy_raw(raw_dir, tmp_path)
+    entry = raw_files.Manifest.load(raw).episodes[1]
+    data = bytearray((raw / entry.file).read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    (raw / entry.file).write_bytes(bytes(data))
+    destination = tmp_path / "out" / "dataset"
+    with pytest.raises(SystemExit) as error:
+        main(["convert", str(raw), "--repo-id", "local/x", "--root", str(destination), "--image-size", "48x64"])
+    assert f"{entry.file} (checksum mismatch)" in str(error.value)
+    assert not destination.exists() and not list(destination.parent.glob(".*"))
+    with pytest.raises(raw_files.RawEpisodeError, match="not a readable raw episode"):
+        raw_files.load_episode(raw / entry.file)
+
+
+def test_a_replay_that_ends_differently_is_an_error(raw_dir, tmp_path):
+    raw = _copy_raw(raw_dir, tmp_path)
+    manifest = raw_files.Manifest.load(raw)
+    entry = max((e for e in manifest.episodes if e.task == "occluded_reach"), key=lambda e: e.seed)  # the 2nd
+    episode = raw_files.load_episode(raw / entry.file)
+    episode.actions[:, canonical.RIGHT.gripper] = -1.0  # never grasps: the replay cannot succeed
+    episode.actions[:, canonical.LEFT.gripper] = -1.0
+    entry.sha256 = raw_files.save_episode(raw / entry.file, episode)
+    manifest.save(raw)
+    with pytest.raises(ReplayError, match=f"occluded_reach seed {entry.seed}: the replay ended with success=False"):
+        convert(ConvertConfig(raw, "local/x", tmp_path / "x", image_size=IMAGE_SIZE, task="occluded_reach"),
+                progress=False)
+    assert not (tmp_path / "x").exists() and not list(tmp_path.glob(".x*"))
+
+
+def test_an_existing_destination_needs_overwrite(raw_dir, tmp_path):
+    (tmp_path / "taken").mkdir()
+    cfg = ConvertConfig(raw_dir, "local/x", tmp_path / "taken", image_size=IMAGE_SIZE, task="peeking_box")
+    with pytest.raises(FileExistsError, match="--overwrite"):
+        convert(cfg, progress=False)
+
+
+def test_lerobot_merges_converted_datasets(raw_dir, tmp_path):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    roots = [convert(ConvertConfig(raw_dir, f"local/{task}", tmp_path / task, image_size=IMAGE_SIZE, task=task),
+                     progress=False) for task in ("peeking_box", "occluded_reach")]
+    merged = tmp_path / "merged"
+    command = [sys.executable, "-m", "lerobot.scripts.lerobot_edit_dataset", "--new_repo_id", "local/merged",
+               "--new_root", str(merged), "--operation.type", "merge",
+               "--operation.repo_ids", "['local/peeking_box', 'local/occluded_reach']",
+               "--operation.roots", str([str(r) for r in roots])]
+    subprocess.run(command, check=True, capture_output=True, timeout=300)
+    dataset = LeRobotDataset("local/merged", root=merged, video_backend="pyav")
+    assert dataset.num_episodes == 4
+    assert {dataset[0]["task_name"], dataset[len(dataset) - 1]["task_name"]} == {"peeking_box", "occluded_reach"}
