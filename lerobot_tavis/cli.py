@@ -58,6 +58,8 @@ def _convert(args: argparse.Namespace) -> None:
         raise ValueError("give exactly one of RAW_DIR (a `tavis record` output) and --from-tavis ROOT")
     image_size = _image_size(args.image_size) if args.image_size else None
     if args.from_tavis:
+        if args.zero_neck:
+            raise ValueError("--zero-neck applies to raw episodes, not to --from-tavis")
         from lerobot_tavis.dataset_tools.from_tavis import convert_from_tavis
 
         root = convert_from_tavis(Path(args.from_tavis), args.repo_id, Path(args.root), fps=args.fps,
@@ -67,7 +69,7 @@ def _convert(args: argparse.Namespace) -> None:
 
         root = convert(ConvertConfig(raw_dir=Path(args.raw_dir), repo_id=args.repo_id, root=Path(args.root),
                                      fps=args.fps, image_size=image_size or (480, 640), cameras=args.cameras,
-                                     task=args.task, overwrite=args.overwrite))
+                                     task=args.task, overwrite=args.overwrite, zero_neck=args.zero_neck))
     print(root)
 
 
@@ -82,6 +84,30 @@ def _pull(args: argparse.Namespace) -> None:
 
     dataset = pull_dataset(args.repo_id, root=args.root, revision=args.revision)
     print(f"{dataset.root}: {dataset.num_episodes} episodes, {dataset.num_frames} frames at {dataset.fps} fps")
+
+
+def _presets(args: argparse.Namespace) -> None:
+    from lerobot_tavis.policy_configs import preset_names, preset_path
+
+    if args.name:
+        print(preset_path(args.name))
+        return
+    for name in preset_names():
+        print(name)
+
+
+def _train(args: argparse.Namespace) -> None:
+    import subprocess
+
+    from lerobot_tavis.policy_configs import missing_pi0_downloads, preset_path
+
+    path = preset_path(args.preset)
+    if args.preset.startswith("pi0") and (missing := missing_pi0_downloads()):
+        raise ValueError(f"pi0 needs {', '.join(missing)}, which are neither in the Hugging Face cache nor "
+                         "downloadable here: log in (`hf auth login`, and accept the PaliGemma licence on the Hub) "
+                         "or fill HF_HOME on a machine with network access")
+    command = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={path}", *args.lerobot_args]
+    sys.exit(subprocess.call(command))
 
 
 def _image_size(text: str) -> tuple[int, int]:
@@ -143,6 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
     conv.add_argument("--cameras", default="head,fixed,left_wrist,right_wrist", help="comma list of cameras")
     conv.add_argument("--task", help="convert only this task")
     conv.add_argument("--overwrite", action="store_true", help="replace an existing destination")
+    conv.add_argument("--zero-neck", action="store_true",
+                      help="neck dims of state and action = 0 (datasets for the fixed-camera presets)")
     conv.set_defaults(run=_convert)
 
     push = commands.add_parser("push", help="upload a converted dataset to the Hugging Face Hub, with its card")
@@ -157,6 +185,16 @@ def build_parser() -> argparse.ArgumentParser:
     pull.add_argument("--root", help="where to put it (default: LeRobot's cache)")
     pull.add_argument("--revision", help="branch, tag or commit")
     pull.set_defaults(run=_pull)
+
+    presets = commands.add_parser("presets", help="list the training presets, or print the path of one")
+    presets.add_argument("name", nargs="?", help="a preset name, e.g. diffusion_headcam")
+    presets.set_defaults(run=_presets)
+
+    train = commands.add_parser("train", help="lerobot-train with a preset (checks pi0 downloads first); "
+                                "extra arguments go to lerobot-train")
+    train.add_argument("preset", help="a preset name (see `tavis presets`)")
+    train.add_argument("lerobot_args", nargs=argparse.REMAINDER, help="e.g. --dataset.root=... --steps=1000")
+    train.set_defaults(run=_train)
 
     report = commands.add_parser("report", help="success rates with Wilson CIs, GALT, plots from eval outputs")
     report.add_argument("eval_dir", help="directory holding lerobot-eval outputs (eval_info.json, episodes.jsonl)")

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
 from lerobot_tavis.dataset_tools.staging import staged_directory
@@ -41,6 +42,7 @@ class ConvertConfig:
     cameras: tuple[str, ...] = ft.CAMERAS
     task: str | None = None
     overwrite: bool = False
+    zero_neck: bool = False  # neck dims of state and action set to 0: fixed-camera training (reference §9)
 
 
 def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
@@ -67,7 +69,7 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     with staged_directory(cfg.root, overwrite=cfg.overwrite) as staging:
         dataset = LeRobotDataset.create(cfg.repo_id, fps=cfg.fps, features=features, root=staging,
                                         robot_type=manifest.robot, use_videos=True, video_backend="pyav")
-        replayer = Replayer(cameras, cfg.image_size, stride)
+        replayer = Replayer(cameras, cfg.image_size, stride, cfg.zero_neck)
         try:
             for entry in tqdm(entries, desc=f"convert {cfg.repo_id}", unit="ep", disable=not progress):
                 episode = load_episode(Path(cfg.raw_dir) / entry.file, entry.sha256)
@@ -79,7 +81,7 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
             replayer.close()
             dataset.finalize()  # also on failure: an unfinalized dataset writes into the staging folder later
         log = {"raw_dir": str(Path(cfg.raw_dir).absolute()), "fps": cfg.fps, "stride": stride,
-               "image_size": list(cfg.image_size), "cameras": list(cameras),
+               "image_size": list(cfg.image_size), "cameras": list(cameras), "zero_neck": cfg.zero_neck,
                "episodes": [{"episode_index": i, "raw_file": e.file, "task": e.task, "seed": e.seed,
                              "max_qpos_deviation": deviations[e.file]} for i, e in enumerate(entries)]}
         (staging / CONVERSION_LOG).write_text(json.dumps(log, indent=1) + "\n")
@@ -95,8 +97,9 @@ def _stride(raw_fps: int, fps: int) -> int:
 class Replayer:
     """Replays raw episodes in one env per task, rendering `cameras` at every `stride`-th step."""
 
-    def __init__(self, cameras: Sequence[str], image_size: tuple[int, int], stride: int):
+    def __init__(self, cameras: Sequence[str], image_size: tuple[int, int], stride: int, zero_neck: bool = False):
         self.cameras = tuple(cameras)
+        self.zero_neck = zero_neck
         self.image_size = image_size
         self.stride = stride
         self.max_deviation = 0.0
@@ -131,6 +134,9 @@ class Replayer:
         frame[ft.STATE_KEY] = obs["agent_pos"].astype(np.float32)
         frame[ft.JOINT_POS_KEY] = obs["joint_pos"].astype(np.float32)
         frame[ft.ACTION_KEY] = np.asarray(action, dtype=np.float32)
+        if self.zero_neck:
+            frame[ft.STATE_KEY][canonical.HEAD] = 0.0
+            frame[ft.ACTION_KEY][canonical.HEAD] = 0.0
         frame[ft.TASK_NAME_KEY] = episode.task
         frame[ft.SPLIT_KEY] = episode.split
         frame["task"] = episode.prompt

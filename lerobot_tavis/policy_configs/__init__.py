@@ -1,0 +1,107 @@
+"""Training presets for `lerobot-train --config_path=<preset>`: pi0 and Diffusion Policy x camera modes.
+
+Each preset is a partial LeRobot `TrainPipelineConfig` (JSON, shipped with the package) following the reference's
+hyper-parameters (reference §9) in LeRobot 0.6 fields: an action chunk of 16 of which 8 are executed at 20 Hz,
+batch 16; diffusion with 2 observation steps, lr 1e-4 and images resized to 240x320; pi0 fine-tuned from
+`lerobot/pi0_base` with lr 2.5e-5. The policy sees only its camera mode's images plus the canonical state
+(`input_features`), and `env.type=tavis` with the same camera mode makes lerobot-train's periodic evaluation run on
+TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.root=... --steps=...`).
+
+- Diffusion presets train offline: the ResNet-18 encoder starts from random weights with group norm. For the
+  reference's ImageNet start (downloaded from download.pytorch.org) add
+  `--policy.pretrained_backbone_weights=ResNet18_Weights.IMAGENET1K_V1 --policy.use_group_norm=false`.
+- Fixed-camera presets (`fixedcam`, `fixed_wrist`) train on a dataset converted with `tavis convert --zero-neck`:
+  the neck dimensions of state and action are 0 in training, as the env reports and applies them in evaluation.
+- pi0 presets need `lerobot/pi0_base` and its tokenizer from the Hub or the local cache; `tavis train` checks that
+  first and says what is missing.
+
+The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
+keeps the two in step.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs.modes import CAMERA_MODES, mode_cameras, neck_locked
+
+PRESET_DIR = Path(__file__).parent
+POLICIES = ("diffusion", "pi0")
+PI0_BASE = "lerobot/pi0_base"
+PI0_TOKENIZER = "google/paligemma-3b-pt-224"
+DIFFUSION_IMAGE_SIZE = (240, 320)
+PI0_IMAGE_SIZE = (480, 640)  # pi0 resizes and pads every camera to 224x224 itself
+CHUNK, EXECUTED = 16, 8
+
+
+def preset_names() -> list[str]:
+    return [f"{policy}_{mode}" for policy in POLICIES for mode in CAMERA_MODES]
+
+
+def preset_path(name: str) -> Path:
+    """The JSON file of preset `name` (e.g. `diffusion_headcam`)."""
+    if name not in preset_names():
+        raise ValueError(f"unknown preset {name!r}; presets: {', '.join(preset_names())}")
+    return PRESET_DIR / f"{name}.json"
+
+
+def build_preset(policy: str, camera_mode: str) -> dict:
+    """The partial TrainPipelineConfig of one preset."""
+    image_size = DIFFUSION_IMAGE_SIZE if policy == "diffusion" else PI0_IMAGE_SIZE
+    inputs = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, *image_size]}
+              for camera in mode_cameras(camera_mode)}
+    inputs["observation.state"] = {"type": "STATE", "shape": [canonical.ACTION_DIM]}
+    common_policy = {"input_features": inputs, "n_action_steps": EXECUTED, "push_to_hub": False}
+    if policy == "diffusion":
+        policy_cfg = {"type": "diffusion", **common_policy, "n_obs_steps": 2, "horizon": CHUNK,
+                      "drop_n_last_frames": CHUNK - EXECUTED - 2 + 1, "resize_shape": list(image_size),
+                      "crop_shape": None, "down_dims": [512, 1024, 2048], "pretrained_backbone_weights": None,
+                      "use_group_norm": True, "optimizer_lr": 1e-4}
+    elif policy == "pi0":
+        policy_cfg = {"type": "pi0", **common_policy, "pretrained_path": PI0_BASE, "chunk_size": CHUNK,
+                      "optimizer_lr": 2.5e-5, "dtype": "bfloat16", "gradient_checkpointing": True}
+    else:
+        raise ValueError(f"policy must be one of {POLICIES}, got {policy!r}")
+    suffix = "-zero-neck" if neck_locked(camera_mode) else ""
+    return {
+        "dataset": {"repo_id": f"local/tavis-head-gr1t2{suffix}", "video_backend": "pyav"},
+        "env": {"type": "tavis", "task": "tavis_head", "robot": "gr1t2", "camera_mode": camera_mode,
+                "image_size": list(image_size)},
+        "policy": policy_cfg,
+        "batch_size": 16,
+        "steps": 200_000 if policy == "diffusion" else 30_000,
+        "env_eval_freq": 20_000,
+        "save_freq": 20_000,
+        "eval": {"n_episodes": 8, "batch_size": 8, "use_async_envs": True},
+    }
+
+
+def write_presets() -> list[Path]:
+    written = []
+    for name in preset_names():
+        policy, mode = name.split("_", 1)
+        path = preset_path(name)
+        path.write_text(json.dumps(build_preset(policy, mode), indent=2) + "\n")
+        written.append(path)
+    return written
+
+
+def missing_pi0_downloads() -> list[str]:
+    """Hub repos a pi0 preset needs that are neither cached nor reachable (empty when all is well)."""
+    from huggingface_hub import HfApi, snapshot_download
+    from huggingface_hub.errors import LocalEntryNotFoundError
+
+    missing = []
+    for repo_id in (PI0_BASE, PI0_TOKENIZER):
+        try:
+            snapshot_download(repo_id, local_files_only=True)
+            continue
+        except LocalEntryNotFoundError:  # not cached: is the Hub there?
+            pass
+        try:
+            HfApi().model_info(repo_id, timeout=10)
+        except Exception as error:  # offline, gated, no token...: any failure means it cannot be loaded
+            missing.append(f"{repo_id} ({type(error).__name__})")
+    return missing
