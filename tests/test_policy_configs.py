@@ -1,0 +1,119 @@
+"""Policy presets: they parse with LeRobot's loader, match a converted dataset and the env, and a diffusion preset
+trains, evaluates periodically on the tavis env and leaves a checkpoint that lerobot-eval runs."""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from lerobot_tavis import canonical
+from lerobot_tavis.cli import main
+from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+from lerobot_tavis.dataset_tools.record import RecordConfig, record
+from lerobot_tavis.policy_configs import build_preset, preset_names, preset_path
+
+TINY = (48, 64)
+# Small enough for a CPU: the preset's network shrunk, 1-second episodes, two denoising steps.
+SMALL_RUN = ["--env.task=conditional_pick", f"--env.image_size=[{TINY[0]},{TINY[1]}]", "--env.episode_length_s=1",
+             f"--policy.resize_shape=[{TINY[0]},{TINY[1]}]", "--policy.down_dims=[16,32,64]",
+             "--policy.num_inference_steps=2", "--policy.device=cpu"]
+
+
+@pytest.fixture(scope="module")
+def dataset_root(tmp_path_factory):
+    """One conditional_pick demonstration converted with all four cameras at 48x64."""
+    scratch = tmp_path_factory.mktemp("presets")
+    record(RecordConfig(scratch / "raw", "gr1t2", ("conditional_pick",), 1), progress=False)
+    return convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=TINY), progress=False)
+
+
+def _parse(name, *overrides):
+    import draccus
+    import lerobot.policies  # noqa: F401  (registers the policy types)
+    from lerobot.configs.train import TrainPipelineConfig
+
+    return draccus.parse(TrainPipelineConfig, config_path=str(preset_path(name)), args=list(overrides))
+
+
+def test_the_shipped_files_are_the_generated_presets():
+    assert len(preset_names()) == 8
+    for name in preset_names():
+        policy, mode = name.split("_", 1)
+        assert json.loads(preset_path(name).read_text()) == build_preset(policy, mode), name
+    with pytest.raises(ValueError, match="unknown preset"):
+        preset_path("act_headcam")
+
+
+@pytest.mark.parametrize("name", preset_names())
+def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_root):
+    from lerobot.datasets.lerobot_dataset import LeRobotDatasetMetadata
+    from lerobot.utils.feature_utils import dataset_to_policy_features
+
+    cfg = _parse(name, "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}")
+    policy, mode = name.split("_", 1)
+    assert cfg.policy.type == policy and cfg.env.type == "tavis" and cfg.env.camera_mode == mode
+    assert (cfg.policy.n_action_steps, cfg.batch_size) == (8, 16)
+    dataset_features = dataset_to_policy_features(LeRobotDatasetMetadata("local/tiny", root=dataset_root).features)
+    env_keys = set(cfg.env.features_map.values())
+    for key, feature in cfg.policy.input_features.items():
+        assert key in dataset_features and key in env_keys, key
+        assert dataset_features[key].shape[0] == feature.shape[0]  # channels / state size
+    cameras = {k.rsplit(".", 1)[1] for k in cfg.policy.input_features if k.startswith("observation.images.")}
+    assert cameras == ({"head"} if mode.startswith("head") else {"fixed"}) | (
+        {"left_wrist", "right_wrist"} if mode.endswith("wrist") else set())
+    if policy == "diffusion":
+        assert (cfg.policy.n_obs_steps, cfg.policy.horizon, cfg.policy.optimizer_lr) == (2, 16, 1e-4)
+        assert tuple(cfg.policy.resize_shape) == (240, 320) and cfg.policy.pretrained_backbone_weights is None
+    else:
+        assert (cfg.policy.chunk_size, cfg.policy.optimizer_lr) == (16, 2.5e-5)
+        assert str(cfg.policy.pretrained_path) == "lerobot/pi0_base"
+
+
+def test_zero_neck_conversion_for_the_fixed_camera_presets(dataset_root, tmp_path):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    raw = dataset_root.parent / "raw"
+    root = convert(ConvertConfig(raw, "local/zero", tmp_path / "zero", image_size=TINY, cameras=("fixed",),
+                                 zero_neck=True), progress=False)
+    table = LeRobotDataset("local/zero", root=root, video_backend="pyav").hf_dataset
+    state, action = (np.stack(table[key]) for key in ("observation.state", "action"))
+    assert np.all(state[:, canonical.HEAD] == 0) and np.all(action[:, canonical.HEAD] == 0)
+    assert np.any(action[:, canonical.LEFT.position] != 0)
+
+
+def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_eval(dataset_root, tmp_path):
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={preset_path('diffusion_headcam')}",
+             "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", *SMALL_RUN, "--steps=2",
+             "--env_eval_freq=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", "--eval.n_episodes=1",
+             "--eval.batch_size=1", "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'train'}"]
+    subprocess.run(train, check=True, capture_output=True, env=env, timeout=600)
+    (periodic,) = [json.loads(line) for line in (tmp_path / "train" / "episodes.jsonl").read_text().splitlines()]
+    assert periodic["task"] == "conditional_pick" and periodic["camera_mode"] == "headcam"
+    checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
+    evaluate = [sys.executable, "-m", "lerobot.scripts.lerobot_eval", f"--policy.path={checkpoint}",
+                "--policy.device=cpu", "--env.type=tavis", "--env.task=conditional_pick",
+                f"--env.image_size=[{TINY[0]},{TINY[1]}]", "--env.episode_length_s=1", "--eval.n_episodes=1",
+                "--eval.batch_size=1", "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'eval'}"]
+    subprocess.run(evaluate, check=True, capture_output=True, env=env, timeout=600)
+    info = json.loads((tmp_path / "eval" / "eval_info.json").read_text())
+    assert info["overall"]["n_episodes"] == 1
+
+
+def test_pi0_presets_say_clearly_what_is_missing_offline(tmp_path):
+    env = {**os.environ, "HF_HUB_OFFLINE": "1", "HF_HOME": str(tmp_path / "hf"), "HF_TOKEN": ""}
+    result = subprocess.run([sys.executable, "-m", "lerobot_tavis.cli", "train", "pi0_headcam", "--steps=1"],
+                            capture_output=True, text=True, env=env, timeout=120)
+    assert result.returncode == 1
+    assert "tavis train: error: pi0 needs lerobot/pi0_base" in result.stderr
+    assert "google/paligemma-3b-pt-224" in result.stderr
+
+
+def test_presets_command_lists_and_locates(capsys):
+    main(["presets"])
+    assert capsys.readouterr().out.split() == preset_names()
+    main(["presets", "pi0_fixed_wrist"])
+    assert capsys.readouterr().out.strip() == str(preset_path("pi0_fixed_wrist"))
