@@ -119,6 +119,8 @@ def test_fixed_camera_modes_hold_the_neck_at_zero(small_env, camera_mode):
     ({"image_size": (480,)}, "image_size must be"),
     ({"image_size": (4, 4)}, "image_size must be within"),
     ({"episode_length_s": 0}, "episode_length_s must be > 0"),
+    ({"fps": 25}, "fps must divide the 60 Hz control rate"),
+    ({"cameras": ("head", "belly")}, "cameras must be distinct names among"),
 ])
 def test_bad_arguments_raise_clear_errors(kwargs, message):
     with pytest.raises(ValueError, match=message):
@@ -127,3 +129,30 @@ def test_bad_arguments_raise_clear_errors(kwargs, message):
 
 def test_gymnasium_env_checker(small_env):
     check_env(small_env(robot="gr1t2", camera_mode="fixedcam", image_size=(24, 32)), skip_render_check=True)
+
+
+def test_a_60hz_env_steps_one_control_tick_and_counts_time_in_seconds(small_env):
+    env = small_env(task="wait_then_act", fps=60, episode_length_s=1.0)
+    env.reset(seed=3)
+    assert env._max_episode_steps == 60 and env.metadata["render_fps"] == 60
+    before = env.data.time
+    env.step(canonical.rest_action())
+    assert env.data.time - before == pytest.approx(1 / 60)
+    green_at = env.task_object.green_at_s
+    steps = round(green_at * 60)
+    for _ in range(steps - 2):
+        env.step(canonical.rest_action())
+    assert not env.task_object.is_green  # after steps - 1 steps of 1/60 s
+    env.step(canonical.rest_action())
+    assert env.task_object.is_green
+
+
+def test_cameras_override_the_mode_and_none_renders_nothing(small_env):
+    env = small_env(camera_mode="headcam", cameras=("fixed", "left_wrist"))
+    obs, _ = env.reset(seed=0)
+    assert list(obs["pixels"]) == ["fixed", "left_wrist"]
+    blind = small_env(cameras=())
+    obs, _ = blind.reset(seed=0)
+    assert obs["pixels"] == {} and obs["agent_pos"].shape == (19,)
+    with pytest.raises(RuntimeError, match="renders no cameras"):
+        blind.render()
