@@ -44,14 +44,14 @@ def run_cell(args: tuple[str, str, str, int]) -> tuple[str, str, str, int, int, 
 
 
 def main() -> None:
-    from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
+    from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
     from lerobot_tavis.metrics.stats import wilson_interval
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--episodes", type=int, default=96)
     parser.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"])
     parser.add_argument("--splits", nargs="+", default=["id", "ood_spatial"])
-    parser.add_argument("--tasks", nargs="+", default=[t for s in SUITES for t in suite_tasks(s)])
+    parser.add_argument("--tasks", nargs="+", default=list(BENCHMARK_TASKS))
     parser.add_argument("--workers", type=int, default=os.cpu_count())
     args = parser.parse_args()
     cells = [(t, r, s, args.episodes) for r in args.robots for t in args.tasks for s in args.splits]

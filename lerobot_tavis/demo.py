@@ -13,12 +13,12 @@ from tqdm import tqdm
 
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_NAMES
-from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 from lerobot_tavis.experts.registry import make_expert
 from lerobot_tavis.media import side_by_side, write_mp4
 
 FPS = 20
-TASKS = tuple(task for suite in SUITES for task in suite_tasks(suite))
+TASKS = BENCHMARK_TASKS
 
 
 def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) -> tuple[list[np.ndarray], bool]:

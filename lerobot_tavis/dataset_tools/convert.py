@@ -22,7 +22,7 @@ from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
 from lerobot_tavis.dataset_tools.staging import staged_directory
-from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
+from lerobot_tavis.envs.tasks.catalog import task_sort_key
 from lerobot_tavis.errors import TavisError
 
 CONVERSION_LOG = "meta/tavis_conversion.json"
@@ -54,10 +54,9 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
 
     cameras = ft.parse_cameras(cfg.cameras)
     manifest = Manifest.load(cfg.raw_dir)
-    stride = _stride(manifest.fps, cfg.fps)
-    order = [task for suite in SUITES for task in suite_tasks(suite)]
+    stride = ft.frame_stride(manifest.fps, cfg.fps)
     entries = sorted((e for e in manifest.episodes if cfg.task in (None, e.task)),
-                     key=lambda e: (order.index(e.task) if e.task in order else len(order), e.task, e.seed))
+                     key=lambda e: (task_sort_key(e.task), e.seed))
     if not entries:
         raise ValueError(f"{cfg.raw_dir} holds no episodes" + (f" of task {cfg.task!r}" if cfg.task else ""))
     damaged = manifest.damaged(cfg.raw_dir)
@@ -88,12 +87,6 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     return Path(cfg.root)
 
 
-def _stride(raw_fps: int, fps: int) -> int:
-    if fps < 1 or raw_fps % fps:
-        raise ValueError(f"fps must divide the recording rate of {raw_fps} Hz (20, 30, 60, ...), got {fps}")
-    return raw_fps // fps
-
-
 class Replayer:
     """Replays raw episodes in one env per task, rendering `cameras` at every `stride`-th step."""
 
@@ -103,12 +96,14 @@ class Replayer:
         self.image_size = image_size
         self.stride = stride
         self.max_deviation = 0.0
-        self._envs: dict[tuple[str, str, str], tuple] = {}  # (robot, task, split) -> (env, camera rig)
+        self._envs: dict[tuple[str, str, str], object] = {}  # (robot, task, split) -> env
+        self._rigs: dict[tuple[str, str, str], object] = {}  # ... -> its camera rig (made after its first reset)
 
     def frames(self, episode: RawEpisode) -> Iterator[dict]:
         """The LeRobot frames of one episode, replaying it; raises ReplayError if it does not end as recorded."""
-        env, rig = self._env(episode)
+        env = self._env(episode)
         obs, _ = env.reset(seed=episode.seed)
+        rig = self._rig(episode, env)
         if env.task_description != episode.prompt:
             raise ReplayError(f"{episode.task} seed {episode.seed}: the replay's prompt {env.task_description!r} "
                               f"differs from the recorded {episode.prompt!r}")
@@ -143,21 +138,27 @@ class Replayer:
         return frame
 
     def _env(self, episode: RawEpisode):
-        """The env of the episode's robot, task and split (rendering nothing itself) and a rig for the cameras."""
+        """The env of the episode's robot, task and split; it renders nothing itself."""
         from lerobot_tavis.envs.env import TavisEnv
-        from lerobot_tavis.envs.rendering import CameraRig
 
         key = (episode.robot, episode.task, episode.split)
         if key not in self._envs:
-            env = TavisEnv(episode.task, episode.robot, split=episode.split, fps=episode.fps,
-                           image_size=self.image_size, cameras=())
-            env.reset(seed=episode.seed)  # builds the simulator
-            rig = CameraRig(env.model, {name: env.world.cameras[name] for name in self.cameras}, self.image_size,
-                            env.task_object.blacked_out_cameras)
-            self._envs[key] = env, rig
+            self._envs[key] = TavisEnv(episode.task, episode.robot, split=episode.split, fps=episode.fps,
+                                       image_size=self.image_size, cameras=())
         return self._envs[key]
 
+    def _rig(self, episode: RawEpisode, env):
+        """The rig rendering the requested cameras from `env` (which must have been reset once)."""
+        from lerobot_tavis.envs.rendering import CameraRig
+
+        key = (episode.robot, episode.task, episode.split)
+        if key not in self._rigs:
+            self._rigs[key] = CameraRig(env.model, {name: env.world.cameras[name] for name in self.cameras},
+                                        self.image_size, env.task_object.blacked_out_cameras)
+        return self._rigs[key]
+
     def close(self) -> None:
-        for env, rig in self._envs.values():
+        for rig in self._rigs.values():
             rig.close()
+        for env in self._envs.values():
             env.close()

@@ -37,6 +37,14 @@ def parse_cameras(text: str | Sequence[str]) -> tuple[str, ...]:
     return cameras
 
 
+def frame_stride(source_fps: int, fps: int) -> int:
+    """Source frames per dataset frame when a `source_fps` recording becomes an `fps` dataset (fps must divide it)."""
+    if not (isinstance(fps, int) and 0 < fps <= source_fps and source_fps % fps == 0):
+        divisors = [d for d in range(1, source_fps + 1) if source_fps % d == 0]
+        raise ValueError(f"fps must divide the source rate {source_fps} Hz, one of {divisors}; got {fps!r}")
+    return source_fps // fps
+
+
 def dataset_features(joint_names: Sequence[str], cameras: Sequence[str],
                      image_size: tuple[int, int]) -> dict[str, dict]:
     """The `features` argument of `LeRobotDataset.create` for a TAVIS dataset."""

@@ -38,7 +38,7 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.staging import staged_directory
-from lerobot_tavis.envs.tasks.catalog import SPLITS, SUITES, TASKS
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SPLITS
 
 SOURCE_CAMERAS = {
     "observation.images.OBS_HEAD": "head",
@@ -65,7 +65,7 @@ def _class_name(task: str) -> str:
 
 
 # The reference's task class names (its `task` field) -> our task names, for the benchmark suites.
-TASK_CLASSES = {_class_name(name): name for name, info in TASKS.items() if info.suite in SUITES}
+TASK_CLASSES = {_class_name(name): name for name in BENCHMARK_TASKS}
 
 
 def task_name_for_class(class_name: str) -> str:
@@ -98,7 +98,7 @@ def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, 
     if task is not None and task not in TASK_CLASSES.values():
         raise ValueError(f"task must be one of {sorted(TASK_CLASSES.values())}, got {task!r}")
     meta = LeRobotDatasetMetadata(f"tavis-benchmark/{source_root.name}", root=source_root)
-    stride = _stride(meta.fps, fps)
+    stride = ft.frame_stride(meta.fps, fps)
     _check_source_features(meta.features)
     robot = _robot_type(meta.robot_type, source_root.name)
     cameras = {key: name for key, name in SOURCE_CAMERAS.items() if key in meta.features}
@@ -126,13 +126,6 @@ def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, 
         finally:  # also on failure: an unfinalized dataset writes its buffered metadata when collected
             dataset.finalize()
     return Path(root)
-
-
-def _stride(source_fps: int, fps: int) -> int:
-    if not (isinstance(fps, int) and 0 < fps <= source_fps and source_fps % fps == 0):
-        divisors = [d for d in range(1, source_fps + 1) if source_fps % d == 0]
-        raise ValueError(f"fps must divide the source rate {source_fps} Hz, one of {divisors}; got {fps!r}")
-    return source_fps // fps
 
 
 def _check_source_features(features: dict) -> None:

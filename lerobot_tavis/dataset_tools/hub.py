@@ -14,7 +14,7 @@ from pathlib import Path
 from urllib.parse import quote
 
 from lerobot_tavis.dataset_tools.features import JOINT_POS_KEY, SPLIT_KEY, STATE_KEY, TASK_NAME_KEY
-from lerobot_tavis.envs.tasks.catalog import TASKS
+from lerobot_tavis.envs.tasks.catalog import TASKS, task_sort_key
 from lerobot_tavis.errors import TavisError
 
 LICENSE = "cc-by-4.0"
@@ -155,9 +155,8 @@ def _task_rows(root: Path) -> list[str]:
     frames = pd.concat([pd.read_parquet(path, columns=columns) for path in sorted(root.glob("data/*/*.parquet"))])
     episodes = frames.groupby("episode_index").agg(task=(TASK_NAME_KEY, "first"), split=(SPLIT_KEY, "first"),
                                                    frames=(TASK_NAME_KEY, "size"))
-    order = {name: i for i, name in enumerate(TASKS)}
     rows = []
-    for task in sorted(episodes["task"].unique(), key=lambda name: (order.get(name, len(order)), name)):
+    for task in sorted(episodes["task"].unique(), key=task_sort_key):
         of_task = episodes[episodes["task"] == task]
         suite = SUITE_TITLES.get(TASKS[task].suite, TASKS[task].suite) if task in TASKS else "unknown"
         splits = ", ".join(f"{split}: {count}" for split, count in of_task["split"].value_counts(sort=False).items())

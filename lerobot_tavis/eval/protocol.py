@@ -12,13 +12,13 @@ from __future__ import annotations
 import json
 import multiprocessing
 import os
-import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from tqdm import tqdm
 
+from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.config import EPISODE_LOG_NAME, expand_tasks
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
@@ -60,16 +60,14 @@ def run_protocol(cfg: ProtocolConfig) -> list[Path]:
         if (final / EVAL_INFO_NAME).exists():
             print(f"{cell.name}: done already, skipped")
             continue
-        partial = cfg.out_dir / f".{cell.name}.partial"
-        shutil.rmtree(partial, ignore_errors=True)
-        partial.mkdir()
         start = time.perf_counter()
-        if cfg.policy_path is None:
-            _run_expert_cell(cfg, cell, partial)
-        else:
-            _run_policy_cell(cfg, cell, partial)
-        (partial / "wall_clock_s.txt").write_text(f"{time.perf_counter() - start:.1f}\n")
-        os.replace(partial, final)
+        with staged_directory(final, overwrite=True) as partial:  # an unfinished cell is replaced
+            partial.mkdir()
+            if cfg.policy_path is None:
+                _run_expert_cell(cfg, cell, partial)
+            else:
+                _run_policy_cell(cfg, cell, partial)
+            (partial / "wall_clock_s.txt").write_text(f"{time.perf_counter() - start:.1f}\n")
         print(f"{cell.name}: {time.perf_counter() - start:.0f} s")
     return write_report(cfg.out_dir)
 

@@ -16,11 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_tavis.envs.config import EPISODE_LOG_NAME
-from lerobot_tavis.envs.tasks.catalog import SPLITS, TASKS
+from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
 from lerobot_tavis.metrics.stats import wilson_interval
 
 EVAL_INFO_NAME = "eval_info.json"
-TASK_ORDER = list(TASKS)
 
 
 @dataclass
@@ -132,7 +131,7 @@ def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
 
 
 def _order(cells) -> tuple[list[str], list[str]]:
-    tasks = sorted({task for task, _ in cells}, key=lambda t: (TASK_ORDER.index(t) if t in TASK_ORDER else 99, t))
+    tasks = sorted({task for task, _ in cells}, key=task_sort_key)
     splits = sorted({split for _, split in cells}, key=lambda s: (SPLITS.index(s) if s in SPLITS else 9, s))
     return tasks, splits
 

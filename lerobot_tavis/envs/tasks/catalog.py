@@ -91,6 +91,15 @@ def suite_tasks(suite: str) -> tuple[str, ...]:
     return names
 
 
+BENCHMARK_TASKS = tuple(name for suite in SUITES for name in suite_tasks(suite))  # the eight TAVIS tasks
+
+
+def task_sort_key(name: str) -> tuple[int, str]:
+    """Sort key putting task names in catalog order (unknown names last, by name): tables, datasets, plots."""
+    order = list(TASKS)
+    return (order.index(name) if name in order else len(order), name)
+
+
 def task_info(name: str) -> TaskInfo:
     try:
         return TASKS[name]
