@@ -19,7 +19,6 @@ from lerobot_tavis.envs.transforms import quat_angle_rad
 from lerobot_tavis.envs.world import World
 
 POSITION_COST = 1.0
-ORIENTATION_COST = 0.3
 POSTURE_COST = 1e-2
 LM_DAMPING = 0.5
 SOLVER_DAMPING = 1e-3
@@ -33,6 +32,8 @@ class ArmIK:
     def __init__(self, robot: Robot):
         self.robot = robot
         self.model = robot.build_spec().compile()
+        for joint, joint_range in robot.ik_joint_ranges.items():
+            self.model.jnt_range[self.model.joint(joint).id] = joint_range
         self.configuration = mink.Configuration(self.model)
         self.arm_qpos = {s: np.array([self.model.joint(j).qposadr[0] for j in robot.arm_joint_names(s)])
                          for s in robot.SIDES}
@@ -40,7 +41,7 @@ class ArmIK:
         arm_dofs = {int(self.model.joint(j).dofadr[0]) for j in arm_joints}
         self.frame_tasks = {
             side: mink.FrameTask(robot.ee_site(side), "site", position_cost=POSITION_COST,
-                                 orientation_cost=ORIENTATION_COST, lm_damping=LM_DAMPING)
+                                 orientation_cost=robot.ik_orientation_cost, lm_damping=LM_DAMPING)
             for side in robot.SIDES
         }
         self.posture_task = mink.PostureTask(self.model, cost=POSTURE_COST)

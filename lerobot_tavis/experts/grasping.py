@@ -23,6 +23,7 @@ STEEP_PITCHES_RAD = np.radians((75.0, 90.0, 60.0, 45.0, 30.0))
 TIGHT_CLEARANCE_M = 0.015  # per side, below which the steep pitches are tried first
 CARRY_TOLERANCE_M = 0.04
 CARRY_PULL_M = 0.08  # the carried pose only has to get the object past the success line
+CARRY_RAISED_PITCH_RAD = -0.35  # fingertips up: brings a held object nearer a stretched arm
 NATURAL_AZIMUTH_RAD = np.pi / 4  # wider azimuths are tried only after every pitch of the natural ones
 MAX_AZIMUTH_RAD = np.pi / 2
 MIN_FINGER_CLEARANCE_M = 0.002  # total; a wide side is still tried, after the narrow one
@@ -176,7 +177,7 @@ def carry_options(grasp: Grasp, carry_m) -> list[Grasp]:
     the body (all get it past the success line)."""
     carry = np.asarray(carry_m, dtype=float)
     nearer = carry + (-CARRY_PULL_M, 0.0, 0.0) if carry[2] > 0.1 else carry
-    pitches = (None, max(grasp.pitch_rad - 0.5, 0.0), 0.0)
+    pitches = (None, max(grasp.pitch_rad - 0.5, 0.0), 0.0, CARRY_RAISED_PITCH_RAD)
     return [replace(grasp, carry_offset_m=tuple(offset), carry_pitch_rad=pitch)
             for offset in (carry, nearer) for pitch in pitches]
 

@@ -15,6 +15,13 @@ from lerobot_tavis.experts.skills import SkilledExpert
 
 HIGH_LIFT = (0.0, 0.0, 0.29)  # success needs the origin above 1.25 m
 SIDE_OF = {"+y": "left", "-y": "right"}
+# where a hand may peek into the box from (box frame, m): back toward the robot from the nominal spot, out from
+# the open side, height of the wrist; the first reachable one is used
+PEEK_BACK_M = (0.0, 0.06, 0.12, 0.18)
+PEEK_OUT_M = (0.24, 0.20, 0.16, 0.12)
+PEEK_Z_M = (1.12, 1.17)
+FINGERTIP_BEYOND_GRASP_M = 0.03
+BOX_CLEARANCE_M = 0.01
 
 
 class PeekingBoxExpert(SkilledExpert):
@@ -32,9 +39,14 @@ class PeekingBoxExpert(SkilledExpert):
         for opening in self.rng.permutation(["+y", "-y"]):
             sign = 1.0 if opening == "+y" else -1.0
             side = SIDE_OF[opening]
-            # far enough out that the fingertips stay outside the box while the wrist camera looks in
-            outside = box_point(self.uniform(-0.05, 0.0), sign * (peeking_box.HALF_WIDTH + 0.24), 1.12)
+            along = self.uniform(-0.05, 0.0)
             inside = box_point(self.uniform(-0.02, 0.04), 0.0, TABLE_TOP_Z + 0.05)
+            # beside the opening, far enough out that the fingertips stay outside the box while the wrist camera
+            # looks in; nearer the body where the arm cannot reach that far
+            options = sorted(((along - back, out, z) for back in PEEK_BACK_M for out in PEEK_OUT_M for z in PEEK_Z_M),
+                             key=lambda o: abs(o[0] - along) + PEEK_OUT_M[0] - o[1] + o[2] - PEEK_Z_M[0])
+            wrists = [box_point(dx, sign * (peeking_box.HALF_WIDTH + out), z) for dx, out, z in options]
+            outside = self.reachable_view(side, [w for w in wrists if self._fingertips_outside(w, inside)], inside)
             yield from self.fixate(outside, (0.1, 0.2))
             yield from self.peek(side, outside, inside)
             if opening == task.open_side:
@@ -47,6 +59,18 @@ class PeekingBoxExpert(SkilledExpert):
         yield from self.look_and_pick(task.target, side=side, pre_rise_m=(0.0, 0.01),
                                       carry_path=[out, out + HIGH_LIFT], toward_rad=float(into_box),
                                       max_azimuth_rad=0.9, pitches_rad=np.radians((15.0, 25.0, 5.0, 35.0)))
+
+
+    def _fingertips_outside(self, wrist, look_at) -> bool:
+        """Whether the fingertips of a hand at `wrist` (world, m) pointing at `look_at` stay clear of the box."""
+        task = self.env.task_object
+        direction = (look_at - wrist) / np.linalg.norm(look_at - wrist)
+        tip = wrist + (self.ik.robot.gripper.grasp_depth_m + FINGERTIP_BEYOND_GRASP_M) * direction
+        rotation = matrix_from_quat(axis_angle_quat((0, 0, 1), task.box_yaw))[:2, :2]
+        x, y = rotation.T @ (tip[:2] - task.box_center)
+        wall = peeking_box.WALL + BOX_CLEARANCE_M
+        return bool(abs(y) > peeking_box.HALF_WIDTH + wall or x < -peeking_box.HALF_DEPTH - wall
+                    or tip[2] > peeking_box.BOTTOM_Z + peeking_box.HEIGHT + wall)
 
 
 class OccludedReachExpert(SkilledExpert):

@@ -21,7 +21,9 @@ from lerobot_tavis.experts.grasping import Grasp, carry_options, grasp_candidate
 from lerobot_tavis.experts.imagination import Imagination
 
 SLOTS = {"left": canonical.LEFT, "right": canonical.RIGHT}
-IMAGINED_ROLLOUTS = 12  # picks tried in imagination before settling for the best of them
+IMAGINED_ROLLOUTS = 24  # picks tried in imagination before settling for the best of them
+VIEW_POSITION_TOLERANCE_M = 0.015  # how closely a looking pose must be reachable
+VIEW_ANGLE_TOLERANCE_RAD = 0.1
 
 
 class SkilledExpert(Expert):
@@ -76,10 +78,9 @@ class SkilledExpert(Expert):
                 action[slots.position], action[slots.quaternion] = rest[slots.position], rest[slots.quaternion]
         return action
 
-    def peek(self, side: str, wrist_at, look_at, duration_s=(0.8, 1.1), dwell_s=(0.4, 0.7),
-             base: np.ndarray | None = None) -> Iterator[Segment]:
-        """Move one hand so that it points from `wrist_at` toward `look_at` (world, m): its wrist camera then looks
-        there; dwell, keeping the gaze still."""
+    def view_action(self, side: str, wrist_at, look_at, base: np.ndarray | None = None) -> np.ndarray:
+        """`base` (default: the current command) with `side`'s hand at `wrist_at` pointing toward `look_at` (world,
+        m), so that its wrist camera looks there, gripper open."""
         wrist_at, look_at = np.asarray(wrist_at, dtype=float), np.asarray(look_at, dtype=float)
         delta = look_at - wrist_at
         pitch = float(np.arctan2(-delta[2], np.linalg.norm(delta[:2])))
@@ -87,7 +88,25 @@ class SkilledExpert(Expert):
         offset = float(np.linalg.norm(delta)) - self.ik.robot.gripper.grasp_depth_m
         action = view.action(self.ik, self.command if base is None else base, offset_m=offset)
         action[SLOTS[side].gripper] = canonical.GRIPPER_OPEN
-        yield Move(action, self.uniform(*duration_s))
+        return action
+
+    def reachable_view(self, side: str, wrist_options, look_at) -> np.ndarray:
+        """The first of `wrist_options` (world, m; in order of preference) from which `side`'s hand can point at
+        `look_at`, by the arm's kinematics; the nearest miss if none can."""
+        misses = []
+        for wrist_at in wrist_options:
+            position_error, angle_error = self.ik.reach_error(
+                self.view_action(side, wrist_at, look_at, canonical.rest_action()), side)
+            if position_error < VIEW_POSITION_TOLERANCE_M and angle_error < VIEW_ANGLE_TOLERANCE_RAD:
+                return np.asarray(wrist_at, dtype=float)
+            misses.append((position_error + self.ik.robot.gripper.grasp_depth_m * angle_error, len(misses), wrist_at))
+        return np.asarray(min(misses)[2], dtype=float)
+
+    def peek(self, side: str, wrist_at, look_at, duration_s=(0.8, 1.1), dwell_s=(0.4, 0.7),
+             base: np.ndarray | None = None) -> Iterator[Segment]:
+        """Move one hand so that it points from `wrist_at` toward `look_at` (world, m): its wrist camera then looks
+        there; dwell, keeping the gaze still."""
+        yield Move(self.view_action(side, wrist_at, look_at, base), self.uniform(*duration_s))
         yield Hold(self.uniform(*dwell_s))
 
     def candidates(self, name: str, side: str, carry_m, **kwargs):

@@ -26,6 +26,9 @@ class Robot(abc.ABC):
     canonical_origin: ClassVar[tuple[float, float, float]]  # world position of the canonical (hip) frame
     rest_posture_seed: ClassVar[dict[str, tuple[float, ...]]]  # seeds the rest calibration (calibration.py)
     gripper: ClassVar[GripperGeometry]
+    # joint ranges (rad) the IK keeps to, narrower than the servos' own, by joint name
+    ik_joint_ranges: ClassVar[dict[str, tuple[float, float]]] = {}
+    ik_orientation_cost: ClassVar[float] = 0.3  # weight of 1 rad of hand tilt against 1 m of position error
     SIDES: ClassVar[tuple[str, str]] = ("left", "right")
     CAMERAS: ClassVar[tuple[str, ...]] = ("head", "left_wrist", "right_wrist")
 

@@ -28,6 +28,7 @@ UPPER_ARM_M = 0.28
 FOREARM_M = 0.28
 NECK_ABOVE_TORSO_M = 0.115
 NECK_FORWARD_PITCH_RAD = math.radians(10.0)
+IK_MIN_ELBOW_BEND_RAD = 0.15  # costs the straight arm 2 mm of reach
 
 SHOULDER = Servo(kp=500.0, force_limit=80.0, armature=0.1, damping=1.0)
 ELBOW = Servo(kp=400.0, force_limit=60.0, armature=0.08, damping=1.0)
@@ -54,6 +55,12 @@ class Reachy2(Robot):
         "left": (-1.5, 1.1, -0.6, -1.65, 0.0, 0.0, 0.0),
         "right": (-1.5, -1.1, 0.6, -1.65, 0.0, 0.0, 0.0),
     }
+    # The elbow servo allows 0.10 rad of hyperextension; an IK step that takes a stretched arm across straight
+    # cannot bend it back (the hand then stays stuck at full reach), so the IK keeps the elbow slightly bent.
+    ik_joint_ranges = {f"{p}_elbow_pitch": (-2.25, -IK_MIN_ELBOW_BEND_RAD) for p in "lr"}
+    # The wrist tilts only ±0.35 rad, so many commanded hand orientations are out of reach: the hand then keeps to
+    # its commanded position rather than stopping short to turn toward an orientation it cannot take.
+    ik_orientation_cost = 0.2
     gripper = GripperGeometry(stroke_m=0.105, palm_length_m=0.05, palm_half_width_m=0.072,
                               finger_length_m=0.06, pad_length_m=0.035, mount_offset_m=0.02)
     head_camera = CameraMount(pos=(0.065, 0.0, 0.062), look_at=(1.065, 0.0, 0.062), up=(0.0, 0.0, 1.0),
