@@ -43,6 +43,29 @@ def test_gaze_arrives_before_the_grasp(tiny_env, task):
     assert leads and all(lead is not None and 0.3 <= lead <= 2.0 for lead in leads), leads
 
 
+@pytest.mark.parametrize("task, seeds", [("multi_shelf_scan", (6, 7, 13)), ("peeking_box", (13, 23, 26))])
+def test_reachy2_succeeds_where_its_arm_used_to_get_stuck(tiny_env, task, seeds):
+    """id seeds that Reachy2's demonstrator failed in every one of its 3 attempts before its IK kept the elbow bent
+    and weighed hand tilt less (top-shelf objects held but left in the shelf), and before it peeked into the box
+    from reachable poses (the arm jammed on the box, the object never grasped)."""
+    env = tiny_env(task, robot="reachy2", cameras=())
+    assert sum(run_episode(env, seed).success for seed in seeds) >= 2
+
+
+def test_peek_falls_back_to_a_reachable_wrist_pose(tiny_env):
+    env = tiny_env("peeking_box", robot="reachy2", cameras=())
+    env.reset(seed=0)
+    expert = make_expert(env, 0)
+    expert.reset()
+    look_at = np.array([0.43, 0.0, 1.05])
+    too_far, reachable = np.array([0.44, 0.31, 1.12]), np.array([0.30, 0.20, 1.12])
+    np.testing.assert_array_equal(expert.reachable_view("left", [too_far, reachable], look_at), reachable)
+    np.testing.assert_array_equal(expert.reachable_view("left", [reachable, too_far], look_at), reachable)
+    # none reachable: the nearest miss
+    farther = np.array([0.60, 0.45, 1.12])
+    np.testing.assert_array_equal(expert.reachable_view("left", [farther, too_far], look_at), too_far)
+
+
 def test_same_seed_same_demonstration(tiny_env):
     env = tiny_env("wait_then_act")
     first, second = run_episode(env, 4), run_episode(env, 4)

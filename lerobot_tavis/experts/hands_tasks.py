@@ -10,6 +10,7 @@ from lerobot_tavis.envs.scene import TABLE_TOP_Z
 from lerobot_tavis.envs.tasks import occluded_reach, peeking_box
 from lerobot_tavis.envs.transforms import axis_angle_quat, matrix_from_quat
 from lerobot_tavis.experts.base import Hold, Move, Segment
+from lerobot_tavis.experts.grasping import PITCHES_RAD
 from lerobot_tavis.experts.head_tasks import LIFT, ClutterExpert
 from lerobot_tavis.experts.skills import SkilledExpert
 
@@ -22,6 +23,7 @@ PEEK_OUT_M = (0.24, 0.20, 0.16, 0.12)
 PEEK_Z_M = (1.12, 1.17)
 FINGERTIP_BEYOND_GRASP_M = 0.03
 BOX_CLEARANCE_M = 0.01
+UNDER_PANEL_PITCHES_RAD = np.radians((15.0, 5.0, 30.0, 45.0, 60.0))
 
 
 class PeekingBoxExpert(SkilledExpert):
@@ -93,7 +95,11 @@ class OccludedReachExpert(SkilledExpert):
             if peeking != side:
                 yield Move(self.at_rest(side=peeking), self.uniform(0.6, 0.9))
         toward = float(np.arctan2(target[1] - sign * 0.18, target[0] - occluded_reach.SCREEN_X))
-        yield from self.look_and_pick(task.target, HIGH_LIFT, side=side, toward_rad=toward, max_azimuth_rad=0.8)
+        # right behind the panel, a flat hand passes under it (beside the post) more easily than around its edge
+        under = abs(target[1]) < occluded_reach.PANEL_HALF_WIDTH
+        yield from self.look_and_pick(task.target, HIGH_LIFT, side=side, toward_rad=toward, max_azimuth_rad=0.8,
+                                      pitches_rad=UNDER_PANEL_PITCHES_RAD if under else PITCHES_RAD,
+                                      pre_rise_m=(0.0, 0.01) if under else (0.05, 0.08))
 
 
 class BlockedClutterExpert(ClutterExpert):

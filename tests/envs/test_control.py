@@ -135,3 +135,13 @@ def test_bad_actions_raise_naming_the_problem(small_env):
     action[9] = np.nan
     with pytest.raises(ValueError, match=r"action\[9\] \(right_ee_z\)"):
         env.step(action)
+
+
+def test_ik_joint_ranges_narrow_only_the_ik_model():
+    robot = make_robot("reachy2")
+    world = build_world(robot, EmptyRoom("id"), image_size=(48, 64))
+    ik = ArmIK(robot)
+    for joint, joint_range in robot.ik_joint_ranges.items():
+        np.testing.assert_allclose(ik.model.jnt_range[ik.model.joint(joint).id], joint_range)
+        servo_range = world.model.jnt_range[world.model.joint(robot.prefix + joint).id]
+        assert servo_range[1] > joint_range[1]  # the simulated joint keeps its full range

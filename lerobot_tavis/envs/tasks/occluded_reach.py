@@ -20,11 +20,12 @@ from lerobot_tavis.envs.tasks.layout import Box2D
 FRAME_RGBA = (0.18, 0.18, 0.18, 1.0)
 PANEL_RGBA = (0.05, 0.05, 0.05, 1.0)
 SCREEN_X = 0.27
+PANEL_HALF_WIDTH = 0.08
 # name -> (full size, centre, colour)
 SCREEN_PARTS = {
     "screen/base": ((0.15, 0.10, 0.02), (SCREEN_X, 0.0, 1.01), FRAME_RGBA),
     "screen/post": ((0.03, 0.03, 0.10), (SCREEN_X, 0.0, 1.07), FRAME_RGBA),
-    "screen/panel": ((0.015, 0.16, 0.40), (SCREEN_X, 0.0, 1.32), PANEL_RGBA),  # spans z 1.12-1.52
+    "screen/panel": ((0.015, 2 * PANEL_HALF_WIDTH, 0.40), (SCREEN_X, 0.0, 1.32), PANEL_RGBA),  # spans z 1.12-1.52
 }
 
 
