@@ -8,7 +8,6 @@ import numpy as np
 
 from lerobot_tavis.envs.scene import TABLE_TOP_Z
 from lerobot_tavis.envs.tasks import occluded_reach, peeking_box
-from lerobot_tavis.envs.transforms import axis_angle_quat, matrix_from_quat
 from lerobot_tavis.experts.base import Hold, Move, Segment
 from lerobot_tavis.experts.grasping import PITCHES_RAD
 from lerobot_tavis.experts.head_tasks import LIFT, ClutterExpert
@@ -31,11 +30,7 @@ class PeekingBoxExpert(SkilledExpert):
 
     def behaviour(self) -> Iterator[Segment]:
         task = self.env.task_object
-        rotation = matrix_from_quat(axis_angle_quat((0, 0, 1), task.box_yaw))
-
-        def box_point(dx, dy, z):
-            return np.array([*(task.box_center + rotation[:2, :2] @ (dx, dy)), z])
-
+        box_point = task.box_point
         yield Hold(self.uniform(0.2, 0.4))
         yield from self.fixate(box_point(0.0, 0.0, peeking_box.BOTTOM_Z + peeking_box.HEIGHT), (0.3, 0.5))
         for opening in self.rng.permutation(["+y", "-y"]):
@@ -57,19 +52,17 @@ class PeekingBoxExpert(SkilledExpert):
         side = SIDE_OF[task.open_side]
         sign = 1.0 if task.open_side == "+y" else -1.0
         into_box = task.box_yaw - sign * np.pi / 2  # approach direction through the opening
-        out = np.array([*(rotation[:2, :2] @ (0.0, sign * 0.22)), 0.0])  # back out through the opening
+        out = np.array([*(task.box_rotation @ (0.0, sign * 0.22)), 0.0])  # back out through the opening
         yield from self.look_and_pick(task.target, side=side, pre_rise_m=(0.0, 0.01),
                                       carry_path=[out, out + HIGH_LIFT], toward_rad=float(into_box),
                                       max_azimuth_rad=0.9, pitches_rad=np.radians((15.0, 25.0, 5.0, 35.0)))
-
 
     def _fingertips_outside(self, wrist, look_at) -> bool:
         """Whether the fingertips of a hand at `wrist` (world, m) pointing at `look_at` stay clear of the box."""
         task = self.env.task_object
         direction = (look_at - wrist) / np.linalg.norm(look_at - wrist)
         tip = wrist + (self.ik.robot.gripper.grasp_depth_m + FINGERTIP_BEYOND_GRASP_M) * direction
-        rotation = matrix_from_quat(axis_angle_quat((0, 0, 1), task.box_yaw))[:2, :2]
-        x, y = rotation.T @ (tip[:2] - task.box_center)
+        x, y = task.box_rotation.T @ (tip[:2] - task.box_center)
         wall = peeking_box.WALL + BOX_CLEARANCE_M
         return bool(abs(y) > peeking_box.HALF_WIDTH + wall or x < -peeking_box.HALF_DEPTH - wall
                     or tip[2] > peeking_box.BOTTOM_Z + peeking_box.HEIGHT + wall)

@@ -56,6 +56,15 @@ class PeekingBox(YcbTask):
         self.box_center = np.array([0.43, 0.0])
         self.box_yaw = 0.0
 
+    @property
+    def box_rotation(self) -> np.ndarray:
+        """2x2 rotation (about z) from the box frame to the world frame."""
+        return matrix_from_quat(axis_angle_quat((0, 0, 1), self.box_yaw))[:2, :2]
+
+    def box_point(self, dx: float, dy: float, z: float) -> np.ndarray:
+        """World point (m) at offset (dx, dy) from the box centre along the box's axes, at height z."""
+        return np.array([*(self.box_center + self.box_rotation @ (dx, dy)), z])
+
     def build(self, spec) -> None:
         super().build(spec)
         box = spec.worldbody.add_body(name=BOX, mocap=True)
@@ -85,8 +94,7 @@ class PeekingBox(YcbTask):
         hx, hy = PROPS[self.target].half_extent_xy(yaw)
         dx = np.clip(rng.uniform(*v.object_dx), -HALF_DEPTH + hx, HALF_DEPTH - hx)
         dy = np.clip(rng.uniform(*v.object_dy), -HALF_WIDTH + hy + 0.003, HALF_WIDTH - hy - 0.003)
-        rotation = matrix_from_quat(axis_angle_quat((0, 0, 1), self.box_yaw))[:2, :2]
-        x, y = self.box_center + rotation @ (dx, dy)
+        x, y, _ = self.box_point(dx, dy, 0.0)
         placement.place_on_table(model, data, self.target, x, y, self.box_yaw + yaw)
         placement.hide(model, data, [n for n in OBJECT_NAMES if n != self.target])
 
