@@ -14,6 +14,7 @@ import mujoco
 import numpy as np
 
 from lerobot_tavis.envs import physics
+from lerobot_tavis.envs.robots import visuals
 from lerobot_tavis.envs.robots.calibration import RestCalibration, calibrate
 from lerobot_tavis.envs.robots.parts import GripperGeometry, JointDef
 from lerobot_tavis.envs.transforms import quat_multiply
@@ -53,11 +54,17 @@ class Robot(abc.ABC):
         self._build(spec)
         return spec
 
-    def build_spec(self) -> mujoco.MjSpec:
-        """The robot with calibrated end-effector frames: the rest quaternion is the relaxed rest orientation."""
+    def build_spec(self, *, dressed: bool = False) -> mujoco.MjSpec:
+        """The robot with calibrated end-effector frames: the rest quaternion is the relaxed rest orientation.
+
+        `dressed` draws the robot with its real visual meshes (`visuals.dress`) instead of its primitives; the
+        physics is the same either way, so the IK controller compiles the cheaper undressed model.
+        """
         spec = self.raw_spec()
         for side, quat in self.calibration().ee_quat_in_hand.items():
             spec.site(self.ee_site(side)).quat = quat
+        if dressed:
+            visuals.dress(spec, self.name)
         return spec
 
     def calibration(self) -> RestCalibration:
