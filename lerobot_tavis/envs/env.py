@@ -17,7 +17,7 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.control import Controller
-from lerobot_tavis.envs.modes import CAMERA_NAMES, mode_cameras, neck_locked
+from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS, mode_cameras, neck_locked
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
@@ -54,8 +54,9 @@ class TavisEnv(gym.Env):
     canonical 19-D state) and `joint_pos` (robot joints, see `Robot.joint_names`). Actions: the canonical 19-D
     action (`lerobot_tavis.canonical`); head angles and gripper values outside their ranges are clipped.
 
-    `cameras` overrides which cameras the observations carry (default: the camera mode's); `()` renders nothing,
-    for recording and replay, which render what they need themselves.
+    `cameras` overrides which cameras the observations carry (default: the camera mode's), e.g. to add the
+    third-person `overview` camera for a video; `()` renders nothing, for recording and replay, which render what
+    they need themselves.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": physics.POLICY_HZ}
@@ -222,8 +223,9 @@ def warm_up_action(rng: np.random.Generator) -> np.ndarray:
 
 def _check_cameras(cameras) -> tuple[str, ...]:
     cameras = tuple(cameras)
-    if not set(cameras) <= set(CAMERA_NAMES) or len(set(cameras)) != len(cameras):
-        raise ValueError(f"cameras must be distinct names among {CAMERA_NAMES}, got {cameras!r}")
+    known = CAMERA_NAMES + VIEW_CAMERAS
+    if not set(cameras) <= set(known) or len(set(cameras)) != len(cameras):
+        raise ValueError(f"cameras must be distinct names among {known}, got {cameras!r}")
     return cameras
 
 

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 CAMERA_NAMES = ("head", "fixed", "left_wrist", "right_wrist")
+# Cameras for people (gallery, videos), never part of a camera mode's observation.
+VIEW_CAMERAS = ("overview",)
 
 CAMERA_MODES: dict[str, tuple[str, ...]] = {
     "headcam": ("head",),

@@ -8,7 +8,7 @@ import mujoco
 import numpy as np
 
 from lerobot_tavis.envs import physics, scene
-from lerobot_tavis.envs.modes import CAMERA_NAMES
+from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS
 from lerobot_tavis.envs.robots import Robot
 from lerobot_tavis.envs.tasks.base import Task
 
@@ -31,7 +31,7 @@ class World:
     arms: dict[str, ArmIndex]
     neck_qpos: np.ndarray  # (3,) roll, pitch, yaw
     neck_actuators: np.ndarray
-    cameras: dict[str, int]  # canonical camera name -> model camera id
+    cameras: dict[str, int]  # camera name (CAMERA_NAMES and VIEW_CAMERAS) -> model camera id
     robot_joint_qpos: np.ndarray  # qpos addresses of Robot.joint_names(), in that order
 
 
@@ -71,13 +71,14 @@ def index_world(model: mujoco.MjModel, robot: Robot) -> World:
         for side in robot.SIDES
     }
     cameras = {name: model.camera(p + name).id for name in robot.CAMERAS}
-    cameras[scene.FIXED_CAMERA] = model.camera(scene.FIXED_CAMERA).id
+    for name in (scene.FIXED_CAMERA, *VIEW_CAMERAS):
+        cameras[name] = model.camera(name).id
     return World(
         model=model,
         robot=robot,
         arms=arms,
         neck_qpos=qpos_of(robot.neck_joint_names()),
         neck_actuators=actuators_of(robot.neck_joint_names()),
-        cameras={name: cameras[name] for name in CAMERA_NAMES},
+        cameras={name: cameras[name] for name in CAMERA_NAMES + VIEW_CAMERAS},
         robot_joint_qpos=qpos_of(robot.joint_names()),
     )
