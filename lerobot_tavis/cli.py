@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 from lerobot_tavis.errors import TavisError
 
 
@@ -15,6 +16,14 @@ def _demo(args: argparse.Namespace) -> None:
     tasks = args.tasks or TASKS
     for path in run_demo(args.out, robots=args.robots, tasks=tasks, image_size=_image_size(args.image_size),
                          seed=args.seed):
+        print(path)
+
+
+def _gallery(args: argparse.Namespace) -> None:
+    from lerobot_tavis.gallery import write_gallery
+
+    for path in write_gallery(args.out, robots=args.robots, tasks=args.tasks or BENCHMARK_TASKS,
+                              image_size=_image_size(args.image_size), seed=args.seed):
         print(path)
 
 
@@ -128,6 +137,15 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--image-size", default="240x320", help="HxW of every camera (default 240x320)")
     demo.add_argument("--seed", type=int, default=0)
     demo.set_defaults(run=_demo)
+
+    gallery = commands.add_parser("gallery", help="stills of every task and robot (first observation, grasp) and "
+                                  "the README overview figure")
+    gallery.add_argument("--out", default="docs/images", help="output directory (default: docs/images)")
+    gallery.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"], choices=["gr1t2", "reachy2"])
+    gallery.add_argument("--tasks", nargs="+", choices=BENCHMARK_TASKS, help="default: the eight TAVIS tasks")
+    gallery.add_argument("--image-size", default="240x320", help="HxW of every view (default 240x320)")
+    gallery.add_argument("--seed", type=int, default=0, help="episode seed of every task (default 0)")
+    gallery.set_defaults(run=_gallery)
 
     evaluate = commands.add_parser("eval", help="the 96-episode protocol for a policy checkpoint or the demonstrators")
     evaluate.add_argument("--policy", help="policy checkpoint directory (pretrained_model)")

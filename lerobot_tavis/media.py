@@ -1,4 +1,4 @@
-"""Videos of camera frames. Files are written to a temporary name and renamed when complete."""
+"""Videos and stills of camera frames. Files are written to a temporary name and renamed when complete."""
 
 from __future__ import annotations
 
@@ -25,6 +25,17 @@ def write_mp4(path: str | Path, frames: list[np.ndarray], fps: int) -> Path:
         for frame in frames:
             container.mux(stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(frame), format="rgb24")))
         container.mux(stream.encode())
+    os.replace(partial, path)
+    return path
+
+
+def write_png(path: str | Path, rgb: np.ndarray) -> Path:
+    """Write an RGB uint8 image (H, W, 3) as PNG."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f".{path.name}.partial.png")
+    if not cv2.imwrite(str(partial), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
+        raise OSError(f"could not write {path}")
     os.replace(partial, path)
     return path
 
