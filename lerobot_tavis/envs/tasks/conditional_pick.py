@@ -9,7 +9,7 @@ import numpy as np
 
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES, add_marker
-from lerobot_tavis.envs.scene import TABLE_TOP_Z
+from lerobot_tavis.envs.scene import TABLE_TOP_Z, Look, use_look
 from lerobot_tavis.envs.tasks.base import YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 from lerobot_tavis.envs.tasks.layout import Box2D
@@ -18,6 +18,8 @@ CARD = "cue_card"
 CARD_SIZE_M = (0.08, 0.05, 0.003)
 RED = (1.0, 0.0, 0.0, 1.0)
 GREEN = (0.0, 1.0, 0.0, 1.0)
+# matte card stock; its colour is the geom's rgba (RED or GREEN), which overrides the material's
+CARD_LOOK = Look("cue_card", specular=0.05, shininess=0.1)
 
 
 @dataclass(frozen=True)
@@ -44,6 +46,7 @@ class ConditionalPick(YcbTask):
     def build(self, spec) -> None:
         super().build(spec)
         add_marker(spec, CARD, mujoco.mjtGeom.mjGEOM_BOX, tuple(s / 2 for s in CARD_SIZE_M), RED)
+        use_look(spec, spec.geom(CARD), CARD_LOOK)
 
     def bind(self, model) -> None:
         super().bind(model)

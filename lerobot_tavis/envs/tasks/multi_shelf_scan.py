@@ -11,13 +11,12 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from lerobot_tavis.envs import physics, placement
+from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.tasks.base import MAX_SUCCESS_SPEED_M_S, YcbTask
 from lerobot_tavis.envs.tasks.catalog import SHELF_PROMPTS, TASKS
 
-WOOD = (0.55, 0.35, 0.20, 1.0)
 SHELF_X, SHELF_DEPTH, SHELF_WIDTH = 0.52, 0.11, 0.70
 BOARD_THICKNESS = 0.02
 BOARD_Z = (0.97, 1.10, 1.27)  # centres of the three shelf boards; the top board is at 1.52
@@ -29,6 +28,15 @@ SLOT_Y_CLAMP = (-0.32, 0.32)
 INNER_X = (SHELF_X - SHELF_DEPTH / 2, SHELF_X + SHELF_DEPTH / 2 - 0.005)  # open front .. back panel
 INNER_Y = (-SHELF_WIDTH / 2, SHELF_WIDTH / 2)
 SUCCESS_X = SHELF_X - SHELF_DEPTH / 2 - 0.03  # 0.435 m
+# This task's own key light (reference §2.5): from behind-left of the robot into the shelf's open front.
+KEY_LIGHT_DIR = (0.643, -0.236, -0.728)
+KEY_LIGHT_INTENSITY = 1000.0
+# Light wood, as the shelf appears in the reference's renders (its base colour (0.55, 0.35, 0.20) is lit there far
+# more strongly than MuJoCo's clamped lighting allows). The back panel is a shade darker, so that the boards stand
+# out against it without shadows.
+SHELF_LOOK = scene.Look("shelf_wood", (0.94, 0.79, 0.58, 1.0), "wood.png", period_m=0.5, specular=0.1, shininess=0.1)
+SHELF_BACK_LOOK = scene.Look("shelf_back", (0.78, 0.64, 0.46, 1.0), "wood.png", period_m=0.5, specular=0.1,
+                             shininess=0.1)
 
 
 @dataclass(frozen=True)
@@ -58,7 +66,9 @@ class MultiShelfScan(YcbTask):
         boxes.append(("shelf/back", (SHELF_X + SHELF_DEPTH / 2 + 0.005, 0.0, mid_z), (0.01, SHELF_WIDTH, height)))
         for name, pos, size in boxes:
             geom = shelf.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX, pos=pos, size=[s / 2 for s in size])
-            physics.style_geom(geom, physics.STATIC, WOOD)
+            physics.style_geom(geom, physics.STATIC)
+            scene.use_look(spec, geom, SHELF_BACK_LOOK if name == "shelf/back" else SHELF_LOOK)
+        scene.set_key_light(spec, KEY_LIGHT_DIR, KEY_LIGHT_INTENSITY)
 
     def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
         chosen = rng.choice(len(SLOTS), size=len(OBJECT_NAMES), replace=False)

@@ -11,21 +11,21 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from lerobot_tavis.envs import physics, placement
+from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES
 from lerobot_tavis.envs.tasks.base import YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 from lerobot_tavis.envs.tasks.layout import Box2D
 
-FRAME_RGBA = (0.18, 0.18, 0.18, 1.0)
-PANEL_RGBA = (0.05, 0.05, 0.05, 1.0)
+FRAME_LOOK = scene.Look("screen_frame", (0.18, 0.18, 0.18, 1.0), specular=0.3, shininess=0.3)  # matte plastic
+PANEL_LOOK = scene.Look("screen_panel", (0.05, 0.05, 0.05, 1.0), specular=0.8, shininess=0.9)  # glossy glass
 SCREEN_X = 0.27
 PANEL_HALF_WIDTH = 0.08
-# name -> (full size, centre, colour)
+# name -> (full size, centre, look)
 SCREEN_PARTS = {
-    "screen/base": ((0.15, 0.10, 0.02), (SCREEN_X, 0.0, 1.01), FRAME_RGBA),
-    "screen/post": ((0.03, 0.03, 0.10), (SCREEN_X, 0.0, 1.07), FRAME_RGBA),
-    "screen/panel": ((0.015, 2 * PANEL_HALF_WIDTH, 0.40), (SCREEN_X, 0.0, 1.32), PANEL_RGBA),  # spans z 1.12-1.52
+    "screen/base": ((0.15, 0.10, 0.02), (SCREEN_X, 0.0, 1.01), FRAME_LOOK),
+    "screen/post": ((0.03, 0.03, 0.10), (SCREEN_X, 0.0, 1.07), FRAME_LOOK),
+    "screen/panel": ((0.015, 2 * PANEL_HALF_WIDTH, 0.40), (SCREEN_X, 0.0, 1.32), PANEL_LOOK),  # spans z 1.12-1.52
 }
 
 
@@ -45,9 +45,10 @@ class OccludedReach(YcbTask):
     def build(self, spec) -> None:
         super().build(spec)
         screen = spec.worldbody.add_body(name="screen")
-        for name, (size, centre, rgba) in SCREEN_PARTS.items():
+        for name, (size, centre, look) in SCREEN_PARTS.items():
             geom = screen.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX, pos=centre, size=[s / 2 for s in size])
-            physics.style_geom(geom, physics.STATIC, rgba)
+            physics.style_geom(geom, physics.STATIC)
+            scene.use_look(spec, geom, look)
 
     def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
         self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]

@@ -11,14 +11,16 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from lerobot_tavis.envs import physics, placement
+from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.tasks.base import YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 from lerobot_tavis.envs.transforms import axis_angle_quat, matrix_from_quat
 
 BOX = "box"
-WOOD = (0.55, 0.35, 0.20, 1.0)
+# light beige board, as the box appears in the reference's renders
+BOX_LOOK = scene.Look("box_board", (0.92, 0.87, 0.77, 1.0), "cardboard.png", period_m=0.25, specular=0.1,
+                      shininess=0.1)
 HALF_DEPTH, HALF_WIDTH, HEIGHT, WALL = 0.20, 0.07, 0.20, 0.008
 BOTTOM_Z = 0.995  # sunk 5 mm into the table
 WALL_Z = BOTTOM_Z + HEIGHT / 2
@@ -71,7 +73,8 @@ class PeekingBox(YcbTask):
         for wall, (size, centre) in WALLS.items():
             geom = box.add_geom(name=f"box/{wall}", type=mujoco.mjtGeom.mjGEOM_BOX, pos=centre,
                                 size=[s / 2 for s in size])
-            physics.style_geom(geom, physics.STATIC, WOOD)
+            physics.style_geom(geom, physics.STATIC)
+            scene.use_look(spec, geom, BOX_LOOK)
 
     def bind(self, model) -> None:
         super().bind(model)

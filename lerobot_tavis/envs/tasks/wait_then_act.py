@@ -14,7 +14,7 @@ import numpy as np
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES, add_marker
 from lerobot_tavis.envs.physics import POLICY_HZ
-from lerobot_tavis.envs.scene import TABLE_TOP_Z
+from lerobot_tavis.envs.scene import TABLE_TOP_Z, Look, use_look
 from lerobot_tavis.envs.tasks.base import YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 from lerobot_tavis.envs.tasks.layout import Box2D
@@ -23,6 +23,8 @@ LIGHT = "signal_light"
 LIGHT_RADIUS_M = 0.03
 RED = (1.0, 0.0, 0.0, 1.0)
 GREEN = (0.0, 1.0, 0.0, 1.0)
+# a glowing lamp; its colour is the geom's rgba (RED or GREEN), which overrides the material's
+LIGHT_LOOK = Look("signal_lamp", specular=0.5, shininess=0.8, emission=0.6)
 
 
 @dataclass(frozen=True)
@@ -49,6 +51,7 @@ class WaitThenAct(YcbTask):
     def build(self, spec) -> None:
         super().build(spec)
         add_marker(spec, LIGHT, mujoco.mjtGeom.mjGEOM_SPHERE, (LIGHT_RADIUS_M, 0.0, 0.0), RED)
+        use_look(spec, spec.geom(LIGHT), LIGHT_LOOK)
 
     def bind(self, model) -> None:
         super().bind(model)

@@ -1,0 +1,161 @@
+"""The arena's look: textured materials on the table and floor, per-task key light, cue colours that still switch,
+procedural textures that their script reproduces, and physics untouched by the drawn-only geoms."""
+
+from pathlib import Path
+
+import cv2
+import mujoco
+import numpy as np
+import pytest
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs import physics, scene
+from lerobot_tavis.envs.assets import ASSET_DIR
+from lerobot_tavis.envs.env import TavisEnv
+from lerobot_tavis.envs.robots import make_robot
+from lerobot_tavis.envs.tasks import multi_shelf_scan
+from lerobot_tavis.envs.tasks.conditional_pick import CARD
+from lerobot_tavis.envs.tasks.registry import TASK_CLASSES, make_task
+from lerobot_tavis.envs.tasks.wait_then_act import LIGHT
+from lerobot_tavis.envs.world import build_world
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _model(task_name: str) -> mujoco.MjModel:
+    return build_world(make_robot("gr1t2"), make_task(task_name), image_size=(16, 16)).model
+
+
+def _texture_of(model: mujoco.MjModel, geom: str) -> int:
+    material = model.geom_matid[model.geom(geom).id]
+    assert material >= 0, f"{geom} has no material"
+    return model.mat_texid[material, mujoco.mjtTextureRole.mjTEXROLE_RGB]
+
+
+def _texture_pixels(model: mujoco.MjModel, texture: int) -> np.ndarray:
+    start, (h, w, c) = model.tex_adr[texture], (model.tex_height[texture], model.tex_width[texture],
+                                                model.tex_nchannel[texture])
+    return model.tex_data[start:start + h * w * c].reshape(h, w, c)
+
+
+def _top_down(model, data, lookat, distance_m: float, size: int = 48) -> np.ndarray:
+    """An image looking straight down at `lookat` (world, m) from `distance_m` above it."""
+    camera = mujoco.MjvCamera()
+    camera.type = mujoco.mjtCamera.mjCAMERA_FREE
+    camera.lookat[:] = lookat
+    camera.distance, camera.elevation, camera.azimuth = distance_m, -90.0, 0.0
+    with mujoco.Renderer(model, size, size) as renderer:
+        renderer.update_scene(data, camera=camera)
+        return renderer.render().astype(float)
+
+
+@pytest.mark.parametrize("task_name", sorted(TASK_CLASSES))
+def test_every_task_compiles_with_textured_floor_and_key_light(task_name):
+    model = _model(task_name)
+    floor_texture = _texture_of(model, "floor/tiles")
+    assert floor_texture >= 0
+    assert model.light(scene.KEY_LIGHT).type == mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
+    if TASK_CLASSES[task_name].has_table:
+        for geom in ("table/top", "table/surface"):
+            assert _texture_of(model, geom) >= 0
+
+
+def test_table_top_is_brushed_metal_texture_and_floor_tiles_repeat_every_half_metre():
+    model = _model("conditional_pick")
+    metal = _texture_pixels(model, _texture_of(model, "table/surface"))
+    assert metal.std() > 1.0  # streaks and smudges, not a flat colour
+    floor_material = model.geom_matid[model.geom("floor/tiles").id]
+    assert model.mat_texuniform[floor_material]
+    # MuJoCo repeats a texuniform texture `texrepeat` times per 2 m
+    np.testing.assert_allclose(model.mat_texrepeat[floor_material], 2.0 / scene.FLOOR_LOOK.period_m)
+
+
+def test_floor_renders_dark_tiles_with_light_grout():
+    env = TavisEnv("conditional_pick", "gr1t2", cameras=())
+    env.reset(seed=0)
+    image = _top_down(env.model, env.data, (-1.5, 1.5, 0.0), 2.0, size=96).mean(axis=2)
+    env.close()
+    tile = np.median(image)
+    bright = image > tile + 20
+    assert tile < 60
+    assert 0.01 < bright.mean() < 0.3  # thin grout lines cross the view
+    assert bright.any(axis=0).sum() > 5 and bright.any(axis=1).sum() > 5  # ... in both directions
+
+
+def test_drawn_only_geoms_leave_physics_alone():
+    model = _model("conditional_pick")
+    floor = model.geom("floor").id
+    assert model.geom_group[floor] == physics.GROUP_HIDDEN
+    assert (model.geom_contype[floor], model.geom_conaffinity[floor]) == (1, 3)
+    for name in ("floor/tiles", "table/surface"):
+        geom = model.geom(name).id
+        assert model.geom_contype[geom] == model.geom_conaffinity[geom] == 0
+        assert model.geom_group[geom] == physics.GROUP_VISIBLE
+    surface, top = model.geom("table/surface").id, model.geom("table/top").id
+    np.testing.assert_allclose(model.geom_size[surface][:2], model.geom_size[top][:2])
+    assert 0 < model.geom_pos[surface][2] - scene.TABLE_TOP_Z < 0.001
+
+
+def test_key_light_direction_and_strength_per_task():
+    default, shelf = _model("conditional_pick"), _model("multi_shelf_scan")
+    key = default.light(scene.KEY_LIGHT)
+    np.testing.assert_allclose(key.dir, np.divide(scene.KEY_LIGHT_DIR, np.linalg.norm(scene.KEY_LIGHT_DIR)),
+                               atol=1e-6)
+    shelf_key = shelf.light(scene.KEY_LIGHT)
+    expected = np.divide(multi_shelf_scan.KEY_LIGHT_DIR, np.linalg.norm(multi_shelf_scan.KEY_LIGHT_DIR))
+    np.testing.assert_allclose(shelf_key.dir, expected, atol=1e-6)
+    np.testing.assert_allclose(shelf_key.diffuse, key.diffuse * multi_shelf_scan.KEY_LIGHT_INTENSITY
+                               / scene.KEY_LIGHT_INTENSITY, atol=1e-6)
+    assert shelf.nlight == default.nlight == 1
+
+
+def test_shadows_are_opt_in_on_the_key_light_only():
+    plain = build_world(make_robot("gr1t2"), make_task("tabletop"), image_size=(16, 16)).model
+    shadowed = build_world(make_robot("gr1t2"), make_task("tabletop"), image_size=(16, 16), shadows=True).model
+    assert not plain.light_castshadow.any()
+    assert shadowed.light_castshadow[shadowed.light(scene.KEY_LIGHT).id]
+    assert shadowed.vis.quality.shadowsize == scene.SHADOW_MAP_PX
+    assert shadowed.vis.quality.offsamples == 0
+
+
+def _is(colour: str, patch: np.ndarray) -> bool:
+    r, g, _ = patch.reshape(-1, 3).mean(axis=0)
+    return r > 2 * g + 40 if colour == "red" else g > 2 * r + 40
+
+
+def test_cue_card_renders_red_or_green_as_its_state_says():
+    seen = set()
+    env = TavisEnv("conditional_pick", "gr1t2", cameras=())
+    for seed in range(20):
+        env.reset(seed=seed)
+        colour = "red" if env.task_object.card_is_red else "green"
+        card = env.data.mocap_pos[env.model.body(CARD).mocapid[0]]
+        image = _top_down(env.model, env.data, card, 0.2)
+        assert _is(colour, image[20:28, 20:28]), f"seed {seed}: the card should look {colour}"
+        seen.add(colour)
+        if len(seen) == 2:
+            break
+    env.close()
+    assert seen == {"red", "green"}
+
+
+def test_signal_light_renders_red_then_green():
+    env = TavisEnv("wait_then_act", "gr1t2", cameras=())
+    env.reset(seed=0)
+    lamp = env.data.mocap_pos[env.model.body(LIGHT).mocapid[0]]
+    assert _is("red", _top_down(env.model, env.data, lamp, 0.2)[20:28, 20:28])
+    while not env.task_object.is_green:
+        env.step(canonical.rest_action())
+    assert _is("green", _top_down(env.model, env.data, lamp, 0.2)[20:28, 20:28])
+    env.close()
+
+
+def test_texture_script_reproduces_the_packaged_textures(monkeypatch):
+    monkeypatch.syspath_prepend(str(ROOT / "tools" / "assets"))
+    import textures
+
+    for name, (make, _) in textures.TEXTURES.items():
+        packaged = cv2.cvtColor(cv2.imread(str(ASSET_DIR / "scene" / name)), cv2.COLOR_BGR2RGB)
+        regenerated = make()
+        assert regenerated.shape == packaged.shape
+        assert np.abs(regenerated.astype(int) - packaged).max() <= 1, name  # float noise may round differently
