@@ -1,29 +1,35 @@
-"""The suite's five YCB objects and the red cube, as coloured primitives.
+"""The suite's five YCB objects and the red cube: sizes, masses, and how each is added to a model.
 
 Sizes are the published YCB dimensions times the benchmark's 0.75 scale, masses the YCB masses times 0.75³
-(reference/robots_objects_physics.md §2). Every object stands upright: a box's third size is its height. The
-collision shape is one primitive; thin visual-only bands on top give each object its recognisable colour pattern.
+(reference/robots_objects_physics.md §2). Every object stands upright (a box's third size is its height) on one
+collision primitive whose centre is the body's origin. Dressed, a YCB object is drawn as its scanned, textured mesh
+(`lerobot_tavis/assets/ycb/`, fitted onto the primitive's extents by `tools/assets/ycb.py`) and the primitive is
+hidden; undressed, the primitive itself is drawn in the object's colour. Physics is the same either way. The red
+cube is always its primitive.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import mujoco
 
-from lerobot_tavis.envs import physics
+from lerobot_tavis.envs import assets, physics
 
 YCB_SCALE = 0.75
 
 
 @dataclass(frozen=True)
-class Band:
-    """A visual colour band covering the object's side between two heights (fractions of its height, 0 = bottom)."""
+class Surface:
+    """How a scanned object's material answers the scene light (MuJoCo material terms, 0-1; no reflections)."""
 
-    bottom: float
-    top: float
-    rgba: tuple[float, float, float, float]
+    specular: float
+    shininess: float
+
+
+METAL = Surface(specular=0.4, shininess=0.5)  # printed tinplate: a soft highlight
+CARDBOARD = Surface(specular=0.08, shininess=0.1)  # printed board: nearly matte
 
 
 @dataclass(frozen=True)
@@ -35,8 +41,8 @@ class PropSpec:
     shape: str  # "cylinder" or "box"
     size_m: tuple[float, ...]
     mass_kg: float
-    rgba: tuple[float, float, float, float]
-    bands: tuple[Band, ...] = field(default=())
+    rgba: tuple[float, float, float, float]  # the primitive's colour when it is drawn
+    surface: Surface | None = None  # a scanned mesh `assets/ycb/<name>.obj` + `.png` exists when set
 
     @property
     def height_m(self) -> float:
@@ -58,29 +64,19 @@ class PropSpec:
         return 0.5 * (self.size_m[0] ** 2 + self.size_m[1] ** 2) ** 0.5
 
 
-def _ycb(name, label, shape, size_mm, mass_g, rgba, bands=()) -> PropSpec:
+def _ycb(name, label, shape, size_mm, mass_g, rgba, surface) -> PropSpec:
     size = tuple(s / 1000.0 * YCB_SCALE for s in size_mm)
-    return PropSpec(name, label, shape, size, mass_g / 1000.0 * YCB_SCALE**3, rgba, tuple(bands))
+    return PropSpec(name, label, shape, size, mass_g / 1000.0 * YCB_SCALE**3, rgba, surface)
 
-
-RED = (0.80, 0.08, 0.07, 1.0)
-WHITE = (0.93, 0.92, 0.88, 1.0)
-SILVER = (0.72, 0.73, 0.75, 1.0)
-BLUE = (0.10, 0.22, 0.62, 1.0)
-YELLOW = (0.95, 0.78, 0.10, 1.0)
-PINK = (0.96, 0.45, 0.62, 1.0)
-BROWN = (0.40, 0.24, 0.12, 1.0)
-CREAM = (0.90, 0.82, 0.62, 1.0)
 
 YCB_OBJECTS: dict[str, PropSpec] = {
     spec.name: spec
     for spec in (
-        _ycb("soup_can", "tomato soup can", "cylinder", (66, 101), 349, SILVER,
-             [Band(0.02, 0.5, WHITE), Band(0.5, 0.97, RED)]),
-        _ycb("meat_can", "potted meat can", "box", (50, 97, 82), 370, BLUE, [Band(0.35, 0.65, YELLOW)]),
-        _ycb("tuna_fish_can", "tuna fish can", "cylinder", (85, 33), 171, SILVER, [Band(0.08, 0.85, BLUE)]),
-        _ycb("gelatin_box", "gelatin box", "box", (28, 85, 73), 97, RED, [Band(0.55, 0.95, PINK)]),
-        _ycb("pudding_box", "pudding box", "box", (35, 110, 89), 187, BROWN, [Band(0.60, 0.85, CREAM)]),
+        _ycb("soup_can", "tomato soup can", "cylinder", (66, 101), 349, (0.78, 0.12, 0.10, 1.0), METAL),
+        _ycb("meat_can", "potted meat can", "box", (50, 97, 82), 370, (0.12, 0.22, 0.60, 1.0), METAL),
+        _ycb("tuna_fish_can", "tuna fish can", "cylinder", (85, 33), 171, (0.20, 0.35, 0.70, 1.0), METAL),
+        _ycb("gelatin_box", "gelatin box", "box", (28, 85, 73), 97, (0.85, 0.15, 0.15, 1.0), CARDBOARD),
+        _ycb("pudding_box", "pudding box", "box", (35, 110, 89), 187, (0.40, 0.24, 0.14, 1.0), CARDBOARD),
     )
 }
 OBJECT_NAMES: tuple[str, ...] = tuple(YCB_OBJECTS)  # the reference's sampling order
@@ -90,11 +86,13 @@ RED_CUBE = PropSpec("red_cube", "red cube", "box", (CUBE_EDGE_M,) * 3, 1000.0 * 
                     (0.9, 0.1, 0.1, 1.0))
 PROPS: dict[str, PropSpec] = {**YCB_OBJECTS, RED_CUBE.name: RED_CUBE}
 
-_BAND_INFLATE_M = 0.0006  # bands sit just outside the collision shape so they never z-fight with it
 
+def add_prop(spec: mujoco.MjSpec, prop: PropSpec, *, dressed: bool = True) -> mujoco.MjsBody:
+    """Add `prop` as a free body named after it; its origin is the centre of its collision shape.
 
-def add_prop(spec: mujoco.MjSpec, prop: PropSpec) -> mujoco.MjsBody:
-    """Add `prop` as a free body named after it; its origin is the centre of its collision shape."""
+    `dressed`: draw a scanned object as its textured mesh (geom `<name>/mesh`) and hide the collision primitive;
+    otherwise the primitive is drawn in `prop.rgba`. Objects without a scan are always drawn as their primitive.
+    """
     body = spec.worldbody.add_body(name=prop.name)
     body.add_freejoint(name=prop.name)
     half_h = prop.height_m / 2
@@ -106,14 +104,22 @@ def add_prop(spec: mujoco.MjSpec, prop: PropSpec) -> mujoco.MjsBody:
     collision.size = _size(geom_type, half_xy, half_h)
     collision.mass = prop.mass_kg
     collision.friction = physics.OBJECT_FRICTION
-    physics.style_geom(collision, physics.PROP, prop.rgba)
-    for i, band in enumerate(prop.bands):
-        geom = body.add_geom(name=f"{prop.name}/band{i}", type=geom_type)
-        band_half = (band.top - band.bottom) * half_h
-        geom.size = _size(geom_type, tuple(h + _BAND_INFLATE_M for h in half_xy), band_half)
-        geom.pos = (0.0, 0.0, -half_h + (band.bottom + band.top) * half_h)
-        physics.style_geom(geom, physics.VISUAL, band.rgba)
+    scanned = dressed and prop.surface is not None
+    physics.style_geom(collision, physics.PROP, prop.rgba,
+                       group=physics.GROUP_HIDDEN if scanned else physics.GROUP_VISIBLE)
+    if scanned:
+        _add_scan(spec, body, prop)
     return body
+
+
+def _add_scan(spec: mujoco.MjSpec, body: mujoco.MjsBody, prop: PropSpec) -> None:
+    """The scanned mesh, texture and material of `prop` (all named `ycb/<name>`) and its visual geom."""
+    asset = f"ycb/{prop.name}"
+    assets.add_mesh(spec, asset, f"{asset}.obj")
+    assets.add_texture(spec, asset, f"{asset}.png")
+    assets.add_material(spec, asset, texture=asset, specular=prop.surface.specular,
+                        shininess=prop.surface.shininess)
+    assets.add_visual_mesh(body, f"{prop.name}/mesh", asset, asset)
 
 
 def _size(geom_type, half_xy: tuple[float, ...], half_height: float) -> tuple[float, float, float]:

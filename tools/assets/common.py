@@ -48,6 +48,9 @@ def decimate(vertices: np.ndarray, faces: np.ndarray, target_faces: int, vertex_
         mesh_set.add_mesh(pymeshlab.Mesh(vertex_matrix=vertices.astype(np.float64), face_matrix=faces,
                                          v_tex_coords_matrix=vertex_uv.astype(np.float64)))
         mesh_set.compute_texcoord_transfer_vertex_to_wedge()
+        # Per-vertex coordinates split vertices along texture seams; merged, the seams become wedge discontinuities
+        # that the texture-aware collapse respects, instead of open borders that it cannot simplify.
+        mesh_set.meshing_remove_duplicate_vertices()
         mesh_set.meshing_decimation_quadric_edge_collapse_with_texture(targetfacenum=target_faces,
                                                                        preserveboundary=True, qualitythr=0.5)
     mesh = mesh_set.current_mesh()
