@@ -1,0 +1,151 @@
+"""Reachy2's vendored visual meshes (assets/reachy2, made by tools/assets/reachy2.py) change what is drawn only."""
+
+import json
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from lerobot_tavis.envs import physics
+from lerobot_tavis.envs.assets import ASSET_DIR
+from lerobot_tavis.envs.robots.reachy2 import Reachy2
+
+GROUP = ASSET_DIR / "reachy2"
+MANIFEST = json.loads((GROUP / "visuals.json").read_text())
+TIP_TOLERANCE_M = 0.002
+FACE_TOLERANCE_M = 0.0005
+CAMERA_CLEARANCE_M = {"head": 0.10, "left_wrist": 0.05, "right_wrist": 0.05}
+MESH = mujoco.mjtGeom.mjGEOM_MESH
+
+
+@pytest.fixture(scope="module")
+def models():
+    robot = Reachy2()
+    return robot.build_spec().compile(), robot.build_spec(dressed=True).compile()
+
+
+def _collision_geoms(model):
+    return {model.geom(g).name: g for g in range(model.ngeom) if model.geom_contype[g] or model.geom_conaffinity[g]}
+
+
+def _mesh_geoms(model, body=None):
+    return [g for g in range(model.ngeom) if model.geom_type[g] == MESH
+            and (body is None or model.geom_bodyid[g] == model.body(body).id)]
+
+
+def test_dressed_and_plain_models_have_the_same_physics(models):
+    plain, dressed = models
+    for count in ("nbody", "njnt", "nq", "nv", "nu", "neq", "ntendon", "nsite", "ncam"):
+        assert getattr(dressed, count) == getattr(plain, count), count
+    for field in ("body_mass", "body_inertia", "body_pos", "body_quat", "body_ipos", "body_iquat", "jnt_range",
+                  "jnt_axis", "dof_armature", "dof_damping", "actuator_gainprm", "actuator_biasprm",
+                  "actuator_ctrlrange", "actuator_forcerange", "site_pos", "site_quat", "cam_pos", "cam_quat"):
+        np.testing.assert_array_equal(getattr(dressed, field), getattr(plain, field), err_msg=field)
+    plain_geoms, dressed_geoms = _collision_geoms(plain), _collision_geoms(dressed)
+    assert plain_geoms.keys() == dressed_geoms.keys()
+    for name, g in plain_geoms.items():
+        h = dressed_geoms[name]
+        for field in ("geom_type", "geom_size", "geom_pos", "geom_quat", "geom_contype", "geom_conaffinity",
+                      "geom_condim", "geom_priority", "geom_friction", "geom_solref", "geom_solimp", "geom_bodyid"):
+            np.testing.assert_array_equal(getattr(dressed, field)[h], getattr(plain, field)[g], err_msg=f"{name} {field}")
+        assert dressed.geom_group[h] == physics.GROUP_HIDDEN, name
+
+
+def test_only_the_massless_meshes_are_drawn_and_they_touch_nothing(models):
+    _, dressed = models
+    meshes = _mesh_geoms(dressed)
+    assert len(meshes) == len(MANIFEST["meshes"])
+    assert all(dressed.geom_contype[g] == 0 and dressed.geom_conaffinity[g] == 0 for g in meshes)
+    assert [g for g in range(dressed.ngeom) if dressed.geom_group[g] < physics.GROUP_HIDDEN] == meshes
+    spec = Reachy2().build_spec(dressed=True)
+    assert all(geom.mass == 0 for geom in spec.geoms if geom.type == MESH)
+
+
+def test_manifest_names_existing_bodies_files_and_materials():
+    spec = Reachy2().build_spec()
+    notice = (GROUP / "NOTICE.md").read_text()
+    for entry in MANIFEST["meshes"]:
+        assert spec.body(entry["body"]) is not None, entry["body"]
+        assert (GROUP / entry["file"]).is_file(), entry["file"]
+        assert f"`{entry['file']}`" in notice, entry["file"]
+        assert entry["material"] in MANIFEST["materials"], entry["material"]
+
+
+def test_robot_stays_within_its_triangle_and_size_budgets(models):
+    _, dressed = models
+    assert sum(int(dressed.mesh_facenum[dressed.geom_dataid[g]]) for g in _mesh_geoms(dressed)) <= 25_000
+    assert sum(p.stat().st_size for p in GROUP.iterdir()) <= 3_000_000
+
+
+def _in_frame(data, body, points):
+    """World points in the frame of `body`."""
+    return (points - data.xpos[body]) @ data.xmat[body].reshape(3, 3)
+
+
+def _mesh_world_points(model, data, geom):
+    mesh = model.geom_dataid[geom]
+    verts = model.mesh_vert[model.mesh_vertadr[mesh]:model.mesh_vertadr[mesh] + model.mesh_vertnum[mesh]]
+    return verts @ data.geom_xmat[geom].reshape(3, 3).T + data.geom_xpos[geom]
+
+
+@pytest.mark.parametrize("opening_m", [0.0, 0.03, 0.0525])
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_visual_fingertips_follow_the_collision_pads(models, side, opening_m):
+    _, model = models
+    data = mujoco.MjData(model)
+    for finger in ("a", "b"):
+        data.qpos[model.jnt_qposadr[model.joint(f"{side}_finger_{finger}").id]] = opening_m
+    mujoco.mj_kinematics(model, data)
+    hand = model.body(f"{side[0]}_hand").id
+    for finger, sign in (("a", 1.0), ("b", -1.0)):
+        meshes = _mesh_geoms(model, f"{side}_finger_{finger}")
+        assert meshes, f"{side}_finger_{finger} carries no mesh"
+        visual = _in_frame(data, hand, np.concatenate([_mesh_world_points(model, data, g) for g in meshes]))
+        pad = model.geom(f"{side}_finger_{finger}_pad").id
+        centre = _in_frame(data, hand, data.geom_xpos[pad])
+        half = model.geom_size[pad]
+        assert visual[:, 2].min() == pytest.approx(centre[2] - half[2], abs=TIP_TOLERANCE_M)  # fingertip
+        gripping_face = visual[:, 1].min() if sign > 0 else visual[:, 1].max()
+        assert gripping_face == pytest.approx(sign * opening_m, abs=FACE_TOLERANCE_M)
+        assert (visual[:, 0].min() + visual[:, 0].max()) / 2 == pytest.approx(centre[0], abs=TIP_TOLERANCE_M)
+
+
+def _nearest_drawn_hit(model, data, camera, width=640, height=480):
+    """Distance (m) to the nearest drawn geom seen through a grid of rays over the camera's image."""
+    cam = model.camera(camera).id
+    half_v = math.tan(math.radians(model.cam_fovy[cam]) / 2)
+    rotation = data.cam_xmat[cam].reshape(3, 3)
+    drawn, hit = np.array([1, 1, 1, 0, 0, 0], dtype=np.uint8), np.zeros(1, dtype=np.int32)
+    nearest = math.inf
+    for u in np.linspace(-half_v * width / height, half_v * width / height, 33):
+        for v in np.linspace(-half_v, half_v, 25):
+            ray = rotation @ (np.array([u, v, -1.0]) / np.linalg.norm([u, v, -1.0]))
+            distance = mujoco.mj_ray(model, data, data.cam_xpos[cam], ray, drawn, 1, -1, hit)
+            if distance >= 0:
+                nearest = min(nearest, distance)
+    return nearest
+
+
+@pytest.mark.parametrize("roll, pitch, yaw", [(0.0, 0.0, 0.0), (0.35, 0.35, 1.0), (-0.35, -0.35, -1.57)])
+def test_no_mesh_sits_in_front_of_the_cameras(models, roll, pitch, yaw):
+    _, model = models
+    data = mujoco.MjData(model)
+    for joint, angle in (("neck_roll", roll), ("neck_pitch", pitch), ("neck_yaw", yaw)):
+        data.qpos[model.jnt_qposadr[model.joint(joint).id]] = angle
+    for side in ("left", "right"):
+        for finger in ("a", "b"):
+            data.qpos[model.jnt_qposadr[model.joint(f"{side}_finger_{finger}").id]] = 0.0525 * (pitch > 0)
+    mujoco.mj_forward(model, data)
+    for camera, clearance in CAMERA_CLEARANCE_M.items():
+        assert _nearest_drawn_hit(model, data, camera) >= clearance, camera
+
+
+def test_finger_b_carries_finger_a_turned_half_a_turn_about_the_approach_axis():
+    quats = {}
+    for entry in MANIFEST["meshes"]:
+        if entry["body"].endswith(("_finger_a", "_finger_b")):
+            quats.setdefault(entry["file"], {})[entry["body"][-1]] = entry.get("quat", [1.0, 0.0, 0.0, 0.0])
+    assert quats
+    for pair in quats.values():
+        assert pair == {"a": [1.0, 0.0, 0.0, 0.0], "b": [0.0, 0.0, 0.0, 1.0]}
