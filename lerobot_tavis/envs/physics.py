@@ -26,8 +26,9 @@ PROP = {"contype": 1, "conaffinity": 3}
 ROBOT = {"contype": 2, "conaffinity": 0}
 VISUAL = {"contype": 0, "conaffinity": 0}
 
-# Geom groups: 0-2 are drawn by the renderer, 3 is hidden (collision-only shapes).
-GROUP_VISIBLE, GROUP_HIDDEN = 0, 3
+# Geom groups: 0-2 are drawn by the renderer, 3 is hidden (collision-only shapes), 4 is hidden too (the drawn geoms
+# of props parked out of the episode; placement.py moves them between 0 and 4).
+GROUP_VISIBLE, GROUP_HIDDEN, GROUP_PARKED = 0, 3, 4
 
 
 def configure_compiler(spec: mujoco.MjSpec) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.objects import PROPS
 from lerobot_tavis.envs.scene import TABLE_TOP_Z
 from lerobot_tavis.envs.transforms import axis_angle_quat
@@ -19,6 +20,7 @@ def set_free_pose(model: mujoco.MjModel, data: mujoco.MjData, body: str, pos, ya
     data.qpos[qpos:qpos + 3] = pos
     data.qpos[qpos + 3:qpos + 7] = axis_angle_quat((0.0, 0.0, 1.0), yaw_rad)
     data.qvel[qvel:qvel + 6] = 0.0
+    _set_drawn(model, body, True)
 
 
 def standing_z(prop: str, surface_z: float = TABLE_TOP_Z) -> float:
@@ -31,10 +33,23 @@ def place_on_table(model, data, prop: str, x: float, y: float, yaw_rad: float) -
 
 
 def hide(model, data, props: list[str] | tuple[str, ...]) -> None:
-    """Park `props` on the floor behind the robot, each on its own spot."""
+    """Park `props` on the floor behind the robot, each on its own spot, and stop drawing them (the overview camera,
+    or a head turned right round, would see them there). Placing a prop again draws it again."""
     for prop in props:
         slot = list(PROPS).index(prop)
         set_free_pose(model, data, prop, (HIDDEN_XY[0], HIDDEN_XY[1] + 0.25 * slot, standing_z(prop, 0.0)))
+        _set_drawn(model, prop, False)
+
+
+def _set_drawn(model: mujoco.MjModel, body: str, drawn: bool) -> None:
+    """Move the drawn geoms of `body` between the visible group and the parked (undrawn) one; rendering only."""
+    body_id = model.body(body).id
+    start = model.body_geomadr[body_id]
+    for geom in range(start, start + model.body_geomnum[body_id]):
+        if drawn and model.geom_group[geom] == physics.GROUP_PARKED:
+            model.geom_group[geom] = physics.GROUP_VISIBLE
+        elif not drawn and model.geom_group[geom] == physics.GROUP_VISIBLE:
+            model.geom_group[geom] = physics.GROUP_PARKED
 
 
 def set_mocap_pose(model: mujoco.MjModel, data: mujoco.MjData, body: str, pos, yaw_rad: float = 0.0) -> None:

@@ -175,14 +175,14 @@ def add_fixed_camera(spec: mujoco.MjSpec) -> None:
 
 # Third-person view for people (gallery, videos), never observed by a policy: front-right, above the table edge.
 OVERVIEW_CAMERA = "overview"
-OVERVIEW_CAMERA_POS = (1.15, -0.80, 1.70)
-OVERVIEW_LOOK_AT = (0.25, 0.0, 1.02)
+OVERVIEW_CAMERA_POS = (1.20, -0.90, 1.90)
+OVERVIEW_LOOK_AT = (0.15, 0.0, 1.15)
 
 
 def add_overview_camera(spec: mujoco.MjSpec) -> None:
     forward = np.subtract(OVERVIEW_LOOK_AT, OVERVIEW_CAMERA_POS)
     spec.worldbody.add_camera(name=OVERVIEW_CAMERA, pos=OVERVIEW_CAMERA_POS,
-                              quat=camera_quat(forward, up=(0.0, 0.0, 1.0)), fovy=50.0)
+                              quat=camera_quat(forward, up=(0.0, 0.0, 1.0)), fovy=42.0)
 
 
 def add_arena(spec: mujoco.MjSpec, *, table: bool = True, shadows: bool = False) -> None:

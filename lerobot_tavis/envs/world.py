@@ -40,10 +40,7 @@ def build_world(robot: Robot, task: Task, *, image_size: tuple[int, int], shadow
     spec.modelname = f"tavis_{task.info.name}_{robot.name}"
     physics.configure(spec, image_size=image_size)
     scene.add_arena(spec, table=task.has_table, shadows=shadows)
-    # INTERIM (removed at integration): dress only robots whose visuals.json exists yet
-    from lerobot_tavis.envs.assets import ASSET_DIR
-    dressed = (ASSET_DIR / robot.name / "visuals.json").exists()
-    spec.attach(robot.build_spec(dressed=dressed), prefix=robot.prefix, frame=spec.worldbody.add_frame())
+    spec.attach(robot.build_spec(dressed=True), prefix=robot.prefix, frame=spec.worldbody.add_frame())
     task.build(spec)
     model = spec.compile()
     task.bind(model)

@@ -156,3 +156,14 @@ def test_cameras_override_the_mode_and_none_renders_nothing(small_env):
     assert obs["pixels"] == {} and obs["agent_pos"].shape == (19,)
     with pytest.raises(RuntimeError, match="renders no cameras"):
         blind.render()
+
+
+def test_the_overview_camera_is_for_people_only(small_env):
+    for camera_mode in ("headcam", "fixedcam", "head_wrist", "fixed_wrist"):
+        assert "overview" not in small_env(camera_mode=camera_mode).camera_names
+    env = small_env(cameras=("overview", "head"))
+    obs, _ = env.reset(seed=0)
+    overview, head = obs["pixels"]["overview"], obs["pixels"]["head"]
+    assert overview.shape == head.shape and overview.std() > 10 and not np.array_equal(overview, head)
+    with pytest.raises(ValueError, match="overview"):
+        small_env(cameras=("topdown",))

@@ -236,3 +236,22 @@ def test_task_metadata_is_readable_without_a_simulator():
     assert info.suite == "tavis_head" and len(info.prompts) == 15 and "0.435" in info.success_rule
     assert TASKS["peeking_box"].prompts == ("Retrieve the object from inside the box.",)
     assert TavisEnv(task="peeking_box")._sim is None
+
+
+def _drawn(model, body):
+    """Whether any geom of `body` is in a group the renderer draws (0-2)."""
+    start = model.body(body).geomadr[0]
+    return bool((model.geom_group[start:start + model.body(body).geomnum[0]] <= 2).any())
+
+
+def test_parked_props_are_not_drawn_and_placed_props_are():
+    task, model, data = _world("conditional_pick", "id")
+    rng = np.random.default_rng(4)
+    drawn_once = set()
+    for _ in range(20):
+        task.initialize_episode(model, data, rng)
+        placed = {task.left_object, task.right_object}
+        for name in OBJECT_NAMES:
+            assert _drawn(model, name) == (name in placed), name
+        drawn_once |= placed
+    assert drawn_once == set(OBJECT_NAMES)  # every prop was parked, then placed and drawn again
