@@ -1,11 +1,17 @@
-"""Policy steps per second of TavisEnv with rendering, per robot x camera mode x image size.
+"""Policy steps per second of TavisEnv with rendering, per robot x camera mode x image size, and the render cost.
 
-    python benchmarks/env_speed.py [--steps 200] [--robots gr1t2 reachy2] [--shadows]
+    python benchmarks/env_speed.py [--steps 200] [--robots gr1t2 reachy2] [--shadows] [--repeats 3]
+                                   [--peer-python /path/to/python-with-gym-aloha]
 
 Each configuration runs in a fresh process (one GL context, like one vector-env worker): reset, 10 warm-up
-steps, then `--steps` timed steps of a scripted head-and-arm motion. Prints a Markdown table.
-`--shadows` measures every configuration twice, without and with the key light's shadows (TavisEnv(shadows=True)),
-in the same run.
+steps, then `--steps` timed steps of a scripted head-and-arm motion, then 50 timed renders of the mode's cameras
+alone (the render cost per frame, milliseconds per camera image). `--shadows` measures every configuration without
+and with the key light's shadows. With `--repeats`, the configurations are measured round-robin that many times
+and the medians reported, so a change of machine load hits all of them alike.
+
+The peer is LeRobot's gym-aloha (`AlohaInsertion-v0`, `pixels_agent_pos`: one 480x640 camera image per step plus
+the joint state), measured in the same rounds when it imports in `--peer-python` (default: this interpreter).
+Prints Markdown tables. Measure an older checkout with the same script through `PYTHONPATH=<checkout>`.
 """
 
 from __future__ import annotations
@@ -14,19 +20,24 @@ import argparse
 import json
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import time
 
 CONFIGS = [(mode, size) for mode in ("headcam", "head_wrist") for size in ((240, 320), (480, 640))]
+WARM_UP_STEPS = 10
+RENDER_REPEATS = 50
 
 
-def measure(robot: str, camera_mode: str, size: tuple[int, int], steps: int, shadows: bool = False) -> dict:
+def measure(robot: str, camera_mode: str, size: tuple[int, int], steps: int, shadows: bool) -> dict:
+    """Steps per second, reset time (s) and render cost (ms per camera image) of one configuration."""
     os.environ.setdefault("MUJOCO_GL", "egl")
     import numpy as np
 
     from lerobot_tavis import canonical
     from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.envs.rendering import CameraRig
 
     env = TavisEnv("tabletop", robot, camera_mode=camera_mode, image_size=size, shadows=shadows)
     t0 = time.perf_counter()
@@ -40,14 +51,49 @@ def measure(robot: str, camera_mode: str, size: tuple[int, int], steps: int, sha
         a[canonical.LEFT.position] += 0.05 * np.sin(k / 8)
         return a
 
-    for k in range(10):
+    for k in range(WARM_UP_STEPS):
         env.step(action(k))
     t0 = time.perf_counter()
     for k in range(steps):
         env.step(action(k))
-    elapsed = time.perf_counter() - t0
+    steps_per_s = steps / (time.perf_counter() - t0)
+
+    rig = CameraRig(env.model, {name: env.world.cameras[name] for name in env.camera_names}, size)
+    rig.render(env.data)
+    t0 = time.perf_counter()
+    for _ in range(RENDER_REPEATS):
+        rig.render(env.data)
+    render_ms = (time.perf_counter() - t0) * 1000 / (RENDER_REPEATS * len(env.camera_names))
+    rig.close()
     env.close()
-    return {"steps_per_s": steps / elapsed, "reset_s": reset_s}
+    return {"steps_per_s": steps_per_s, "reset_s": reset_s, "render_ms": render_ms}
+
+
+def measure_aloha(steps: int) -> dict:
+    """Steps per second of gym-aloha's insertion task with pixel observations (random actions)."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    import gym_aloha  # noqa: F401  (registers the gym ids)
+    import gymnasium as gym
+
+    env = gym.make("gym_aloha/AlohaInsertion-v0", obs_type="pixels_agent_pos")
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    for _ in range(WARM_UP_STEPS):
+        env.step(env.action_space.sample())
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        env.step(env.action_space.sample())
+    steps_per_s = steps / (time.perf_counter() - t0)
+    env.close()
+    return {"steps_per_s": steps_per_s}
+
+
+def _run(python: str, steps: int, *one: str) -> dict | None:
+    """One measurement in a fresh process; None when it fails (the peer is not installed there)."""
+    result = subprocess.run([python, __file__, "--steps", str(steps), "--one", *one], capture_output=True, text=True)
+    if result.returncode != 0:
+        return None
+    return json.loads(result.stdout.strip().splitlines()[-1])
 
 
 def main() -> None:
@@ -55,24 +101,53 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=200)
     parser.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"])
     parser.add_argument("--shadows", action="store_true", help="also measure with shadows on")
-    parser.add_argument("--one", nargs=5, metavar=("ROBOT", "MODE", "H", "W", "SHADOWS"), help=argparse.SUPPRESS)
+    parser.add_argument("--repeats", type=int, default=1, help="round-robin rounds; medians are reported")
+    parser.add_argument("--peer-python", default=sys.executable, help="interpreter in which gym_aloha imports")
+    parser.add_argument("--one", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.one:
-        robot, mode, h, w, shadows = args.one
-        print(json.dumps(measure(robot, mode, (int(h), int(w)), args.steps, shadows == "on")))
+        if args.one[0] == "aloha":
+            print(json.dumps(measure_aloha(args.steps)))
+        else:
+            robot, mode, h, w, shadows = args.one
+            print(json.dumps(measure(robot, mode, (int(h), int(w)), args.steps, shadows == "on")))
         return
-    print(f"machine: {platform.node()} {os.cpu_count()} cores, MUJOCO_GL={os.environ.get('MUJOCO_GL', 'egl')}")
-    print("| robot | camera mode | image (HxW) | cameras | shadows | steps/s | reset (s) |")
-    print("|---|---|---|---|---|---|---|")
-    for robot in args.robots:
-        for mode, (h, w) in CONFIGS:
-            for shadows in ("off", "on") if args.shadows else ("off",):
-                out = subprocess.run([sys.executable, __file__, "--steps", str(args.steps), "--one", robot, mode,
-                                      str(h), str(w), shadows], check=True, capture_output=True, text=True).stdout
-                result = json.loads(out.strip().splitlines()[-1])
-                n_cams = 1 if mode == "headcam" else 3
-                print(f"| {robot} | {mode} | {h}x{w} | {n_cams} | {shadows} | {result['steps_per_s']:.1f} "
-                      f"| {result['reset_s']:.2f} |", flush=True)
+
+    configs = [(robot, mode, size, shadows) for robot in args.robots for mode, size in CONFIGS
+               for shadows in (("off", "on") if args.shadows else ("off",))]
+    results = {config: [] for config in configs}
+    peer = []
+    for _ in range(args.repeats):
+        for config in configs:
+            robot, mode, (h, w), shadows = config
+            measured = _run(sys.executable, args.steps, robot, mode, str(h), str(w), shadows)
+            if measured is None:
+                raise SystemExit(f"measuring {config} failed: run it alone with --one {robot} {mode} {h} {w} {shadows}")
+            results[config].append(measured)
+        if (measured := _run(args.peer_python, args.steps, "aloha")) is not None:
+            peer.append(measured["steps_per_s"])
+
+    def median(config, key):
+        return statistics.median(r[key] for r in results[config])
+
+    print(f"machine: {platform.node()} {os.cpu_count()} cores, MUJOCO_GL={os.environ.get('MUJOCO_GL', 'egl')}, "
+          f"{args.repeats} round(s), medians")
+    print("| robot | camera mode | image (HxW) | cameras | shadows | steps/s | render (ms per image) | reset (s) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for config in configs:
+        robot, mode, (h, w), shadows = config
+        print(f"| {robot} | {mode} | {h}x{w} | {1 if mode == 'headcam' else 3} | {shadows} "
+              f"| {median(config, 'steps_per_s'):.1f} | {median(config, 'render_ms'):.2f} "
+              f"| {median(config, 'reset_s'):.2f} |")
+    if not peer:
+        print(f"\npeer: gym_aloha does not import in {args.peer_python}; not measured")
+        return
+    aloha = statistics.median(peer)
+    print(f"\npeer: gym-aloha AlohaInsertion-v0 (pixels_agent_pos) {aloha:.1f} steps/s")
+    for config in configs:
+        robot, mode, (h, w), shadows = config
+        if mode == "head_wrist" and (h, w) == (480, 640):
+            print(f"{robot} head_wrist 480x640 shadows {shadows}: {median(config, 'steps_per_s') / aloha:.1f}x the peer")
 
 
 if __name__ == "__main__":
