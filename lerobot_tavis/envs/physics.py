@@ -14,6 +14,10 @@ POLICY_HZ = 20  # one env step
 SUBSTEPS_PER_TICK = round(1.0 / (CONTROL_HZ * TIMESTEP_S))  # 8 physics steps per 60 Hz tick
 TICKS_PER_STEP = CONTROL_HZ // POLICY_HZ  # 3 ticks per 20 Hz policy step
 
+# Clip planes of every camera (m). The reference clips its fixed and wrist cameras at 0.1 m (its head camera at
+# 0.15 m), so a head pitched down in front of the fixed camera is cut away instead of filling its view.
+NEAR_CLIP_M, FAR_CLIP_M = 0.10, 20.0
+
 CONTACT_SOLREF = (0.01, 1.0)
 CONTACT_SOLIMP = (0.95, 0.99, 0.001, 0.5, 2.0)
 OBJECT_FRICTION = (1.0, 0.005, 0.0001)
@@ -51,8 +55,13 @@ def configure(spec: mujoco.MjSpec, *, image_size: tuple[int, int]) -> None:
     spec.visual.global_.offwidth = max(640, width)
     spec.visual.global_.offheight = max(480, height)
     spec.visual.quality.offsamples = 0  # MSAA costs ~2.5x per frame on a CPU
-    spec.visual.map.znear = 0.005
-    spec.visual.map.zfar = 20.0
+
+
+def set_clip_planes(model: mujoco.MjModel) -> None:
+    """Clip every camera's view to NEAR_CLIP_M..FAR_CLIP_M metres (MuJoCo's clip planes are global and stored
+    relative to the compiled model's extent, so this runs after compiling)."""
+    model.vis.map.znear = NEAR_CLIP_M / model.stat.extent
+    model.vis.map.zfar = FAR_CLIP_M / model.stat.extent
 
 
 def style_geom(geom: mujoco.MjsGeom, role: dict[str, int], rgba=None, *, group: int = GROUP_VISIBLE) -> None:

@@ -43,6 +43,7 @@ def build_world(robot: Robot, task: Task, *, image_size: tuple[int, int], shadow
     spec.attach(robot.build_spec(dressed=True), prefix=robot.prefix, frame=spec.worldbody.add_frame())
     task.build(spec)
     model = spec.compile()
+    physics.set_clip_planes(model)
     task.bind(model)
     return index_world(model, robot)
 

@@ -159,3 +159,21 @@ def test_texture_script_reproduces_the_packaged_textures(monkeypatch):
         regenerated = make()
         assert regenerated.shape == packaged.shape
         assert np.abs(regenerated.astype(int) - packaged).max() <= 1, name  # float noise may round differently
+
+
+def test_cameras_clip_at_a_tenth_of_a_metre_like_the_reference():
+    model = _model("tabletop")
+    assert model.vis.map.znear * model.stat.extent == pytest.approx(physics.NEAR_CLIP_M)
+    assert model.vis.map.zfar * model.stat.extent == pytest.approx(physics.FAR_CLIP_M)
+
+
+def test_a_head_pitched_fully_down_does_not_blind_the_fixed_camera():
+    env = TavisEnv("tabletop", "gr1t2", camera_mode="head_wrist", image_size=(48, 64), cameras=("fixed",))
+    env.reset(seed=0)
+    action = canonical.rest_action()
+    action[canonical.HEAD_PITCH] = 0.87  # the neck's limit: the head leans over the fixed camera
+    for _ in range(30):
+        obs, *_ = env.step(action)
+    dark = (obs["pixels"]["fixed"].max(axis=2) < 30).mean()
+    env.close()
+    assert dark < 0.1  # the head (within 0.1 m of the lens) is clipped; the table and arms stay in view
