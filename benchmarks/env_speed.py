@@ -147,7 +147,8 @@ def main() -> None:
     for config in configs:
         robot, mode, (h, w), shadows = config
         if mode == "head_wrist" and (h, w) == (480, 640):
-            print(f"{robot} head_wrist 480x640 shadows {shadows}: {median(config, 'steps_per_s') / aloha:.1f}x the peer")
+            ratio = median(config, "steps_per_s") / aloha
+            print(f"{robot} head_wrist 480x640 shadows {shadows}: {ratio:.1f}x the peer")
 
 
 if __name__ == "__main__":

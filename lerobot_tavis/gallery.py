@@ -111,8 +111,8 @@ def overview_figure(stills: dict[str, Stills], portraits: dict[str, np.ndarray])
     """
     head = [t for t in BENCHMARK_TASKS if task_info(t).suite == "tavis_head"]
     hands = [t for t in BENCHMARK_TASKS if task_info(t).suite == "tavis_hands"]
-    hands_panel = _panel("TAVIS-Hands (local occlusion and peeking)", HANDS_TINT,
-                         _grid({t: stills[t].grasp for t in hands}, ("head", "overview"), ("head cam", "external view")))
+    hands_grid = _grid({t: stills[t].grasp for t in hands}, ("head", "overview"), ("head cam", "external view"))
+    hands_panel = _panel("TAVIS-Hands (local occlusion and peeking)", HANDS_TINT, hands_grid)
     robots = _stack_horizontal([_stack_vertical([_caption(ROBOT_TITLES[name], image.shape[1]), _pad(image, TILE_PAD)])
                                 for name, image in portraits.items()])
     robots_panel = _panel("Robots", ROBOTS_TINT,

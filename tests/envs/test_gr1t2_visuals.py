@@ -1,4 +1,5 @@
-"""The GR1T2's vendored visual meshes (assets/gr1t2, made by tools/assets/gr1t2.py) change what is drawn only."""
+"""GR1T2-specific checks of its visual meshes: Robotiq pads on the collision pads, a clear head camera (the shared
+checks of both robots are in test_robot_visuals.py)."""
 
 import json
 import math
@@ -7,7 +8,6 @@ import mujoco
 import numpy as np
 import pytest
 
-from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.assets import ASSET_DIR
 from lerobot_tavis.envs.robots.gr1t2 import GR1T2
 from lerobot_tavis.envs.transforms import matrix_from_quat
@@ -21,56 +21,6 @@ HEAD_NEAR_CLIP_M = 0.15  # the reference head camera's near clip
 def models():
     robot = GR1T2()
     return robot.build_spec().compile(), robot.build_spec(dressed=True).compile()
-
-
-def _collision_geoms(model):
-    return {model.geom(g).name: g for g in range(model.ngeom) if model.geom_contype[g] or model.geom_conaffinity[g]}
-
-
-def test_dressing_keeps_the_physics_bit_identical(models):
-    plain, dressed = models
-    for count in ("nbody", "njnt", "nq", "nv", "nu", "neq", "ntendon", "nsite", "ncam"):
-        assert getattr(dressed, count) == getattr(plain, count), count
-    for field in ("body_mass", "body_inertia", "body_pos", "body_quat", "body_ipos", "body_iquat", "jnt_range",
-                  "jnt_axis", "dof_armature", "dof_damping", "actuator_gainprm", "actuator_biasprm",
-                  "actuator_ctrlrange", "actuator_forcerange", "site_pos", "site_quat", "cam_pos", "cam_quat"):
-        np.testing.assert_array_equal(getattr(dressed, field), getattr(plain, field), err_msg=field)
-    plain_geoms, dressed_geoms = _collision_geoms(plain), _collision_geoms(dressed)
-    assert plain_geoms.keys() == dressed_geoms.keys()
-    for name, g in plain_geoms.items():
-        h = dressed_geoms[name]
-        for field in ("geom_type", "geom_size", "geom_pos", "geom_quat", "geom_contype", "geom_conaffinity",
-                      "geom_condim", "geom_priority", "geom_friction", "geom_solref", "geom_solimp", "geom_bodyid"):
-            np.testing.assert_array_equal(getattr(dressed, field)[h], getattr(plain, field)[g],
-                                          err_msg=f"{name} {field}")
-        assert dressed.geom_group[h] == physics.GROUP_HIDDEN, name
-
-
-def test_meshes_are_drawn_massless_and_touch_nothing(models):
-    _, dressed = models
-    meshes = [g for g in range(dressed.ngeom) if dressed.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
-    assert len(meshes) == len(MANIFEST["meshes"])
-    assert all(dressed.geom_contype[g] == 0 and dressed.geom_conaffinity[g] == 0 for g in meshes)
-    assert all(dressed.geom_group[g] < physics.GROUP_HIDDEN for g in meshes)
-    spec = GR1T2().build_spec(dressed=True)
-    assert all(geom.mass == 0 for geom in spec.geoms if geom.type == mujoco.mjtGeom.mjGEOM_MESH)
-    drawn = [g for g in range(dressed.ngeom) if dressed.geom_group[g] < physics.GROUP_HIDDEN]
-    assert drawn == meshes  # no primitive is drawn any more
-
-
-def test_manifest_names_existing_bodies_files_and_materials():
-    spec = GR1T2().build_spec()
-    for entry in MANIFEST["meshes"]:
-        assert spec.body(entry["body"]) is not None, entry["body"]
-        assert (ASSET_DIR / "gr1t2" / entry["file"]).is_file(), entry["file"]
-        assert entry["material"] in MANIFEST["materials"], entry["material"]
-
-
-def test_robot_stays_within_its_triangle_and_size_budgets(models):
-    _, dressed = models
-    meshes = [g for g in range(dressed.ngeom) if dressed.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
-    assert sum(int(dressed.mesh_facenum[dressed.geom_dataid[g]]) for g in meshes) <= 25_000
-    assert sum(p.stat().st_size for p in (ASSET_DIR / "gr1t2").iterdir()) <= 3_000_000
 
 
 def _in_hand_frame(model, data, hand, geom, points):

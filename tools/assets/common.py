@@ -7,8 +7,11 @@ download anything. Meshes are written in metres, in the frame of the body or obj
 
 from __future__ import annotations
 
+import shutil
 import struct
 import subprocess
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,6 +28,27 @@ def read_git_file(repo: Path, commit: str, path: str) -> bytes:
     if result.returncode != 0:
         raise SystemExit(f"cannot read {path} at {commit} in {repo}: {result.stderr.decode().strip()}")
     return result.stdout
+
+
+@contextmanager
+def staged_group(group: str, max_bytes: int) -> Iterator[Path]:
+    """A fresh staging folder for the asset group `group`. When the block ends without error and the folder holds at
+    most `max_bytes`, it replaces `lerobot_tavis/assets/<group>` whole; otherwise the packaged group is left as it
+    was. The staging folder never outlives the block."""
+    out_dir = PACKAGE_ASSETS / group
+    staging = PACKAGE_ASSETS / f".{group}.staging"
+    shutil.rmtree(staging, ignore_errors=True)
+    staging.mkdir(parents=True)
+    try:
+        yield staging
+        total = sum(path.stat().st_size for path in staging.iterdir())
+        if total > max_bytes:
+            raise SystemExit(f"the {group} assets take {total / 1e6:.2f} MB, over the {max_bytes / 1e6:.1f} MB budget")
+        shutil.rmtree(out_dir, ignore_errors=True)
+        staging.rename(out_dir)
+        print(f"wrote {out_dir} ({total / 1e6:.2f} MB)")
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
 
 
 def decimate(vertices: np.ndarray, faces: np.ndarray, target_faces: int, vertex_uv: np.ndarray | None = None):

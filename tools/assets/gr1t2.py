@@ -35,7 +35,6 @@ import hashlib
 import io
 import json
 import re
-import shutil
 import sys
 import xml.etree.ElementTree as ET
 import zipfile
@@ -49,11 +48,10 @@ import trimesh
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import cad  # noqa: E402
 import robotiq  # noqa: E402
-from common import PACKAGE_ASSETS, Provenance, decimate, read_git_file, write_notice, write_stl  # noqa: E402
+from common import Provenance, decimate, read_git_file, staged_group, write_notice, write_stl  # noqa: E402
 
 from lerobot_tavis.envs.robots.gr1t2 import PELVIS_HEIGHT_M, GR1T2  # noqa: E402
 
-OUT_DIR = PACKAGE_ASSETS / "gr1t2"
 WHEEL_NAME = "fourier_robot_descriptions-0.2.7-py3-none-any.whl"
 WHEEL_SHA256 = "795fd084b94bd6058c187e327f3891259ae952be52e4d7c45d3c45ef96ec1885"
 RECORD_PATH = "fourier_robot_descriptions-0.2.7.dist-info/RECORD"
@@ -463,25 +461,18 @@ def main() -> None:
     if missing:
         raise SystemExit(f"URDF links with a visual and `PIECES` must match; they differ by {sorted(missing)}")
 
-    staging = OUT_DIR.with_name(OUT_DIR.name + ".tmp")
-    shutil.rmtree(staging, ignore_errors=True)
-    staging.mkdir(parents=True)
-    outputs = bake_links(wheel, urdf_text, urdf, ours, mapping, staging)
-    outputs += bake_gripper(args.lerobot_mirror, ours, staging)
-    triangles = sum(o.faces * len(o.bodies) for o in outputs)
-    if triangles > MAX_TRIANGLES:
-        raise SystemExit(f"the dressed GR1T2 draws {triangles:,} triangles, over the {MAX_TRIANGLES:,} budget")
-    write_manifest(staging, outputs)
-    (staging / "LICENSE-fourier-robot-descriptions.txt").write_bytes(wheel.read(WHEEL_LICENSE_PATH))
-    (staging / "LICENSE-robotiq_2f85.txt").write_bytes(
-        read_git_file(args.lerobot_mirror, robotiq.COMMIT, robotiq.source_path("LICENSE")))
-    write_notice(staging, "GR1T2 with Robotiq 2F-85 grippers", INTRO, [o.provenance for o in outputs])
-    total = sum(p.stat().st_size for p in staging.iterdir())
-    if total > MAX_BYTES:
-        raise SystemExit(f"the gr1t2 assets take {total / 1e6:.2f} MB, over the {MAX_BYTES / 1e6:.0f} MB budget")
-    shutil.rmtree(OUT_DIR, ignore_errors=True)
-    staging.rename(OUT_DIR)
-    print(f"wrote {OUT_DIR}: {triangles:,} triangles drawn, {total / 1e6:.2f} MB")
+    with staged_group("gr1t2", MAX_BYTES) as staging:
+        outputs = bake_links(wheel, urdf_text, urdf, ours, mapping, staging)
+        outputs += bake_gripper(args.lerobot_mirror, ours, staging)
+        triangles = sum(o.faces * len(o.bodies) for o in outputs)
+        if triangles > MAX_TRIANGLES:
+            raise SystemExit(f"the dressed GR1T2 draws {triangles:,} triangles, over the {MAX_TRIANGLES:,} budget")
+        write_manifest(staging, outputs)
+        (staging / "LICENSE-fourier-robot-descriptions.txt").write_bytes(wheel.read(WHEEL_LICENSE_PATH))
+        (staging / "LICENSE-robotiq_2f85.txt").write_bytes(
+            read_git_file(args.lerobot_mirror, robotiq.COMMIT, robotiq.source_path("LICENSE")))
+        write_notice(staging, "GR1T2 with Robotiq 2F-85 grippers", INTRO, [o.provenance for o in outputs])
+    print(f"{triangles:,} triangles drawn")
 
 
 PYPI_SOURCE = f"PyPI `fourier-robot-descriptions` 0.2.7 (`{WHEEL_NAME}`)"

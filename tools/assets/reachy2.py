@@ -34,7 +34,6 @@ import io
 import json
 import math
 import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -63,7 +62,7 @@ DAE_PATHS = {
     "pincette_distal": "dynamixel_description/meshes/pincette_distal.dae",
 }
 OBJ_MISSING_FROM_MIRROR = {"upper_arm_visual"}
-OUT_DIR = common.PACKAGE_ASSETS / "reachy2"
+MAX_BYTES = 3_000_000  # the whole group
 
 # Our materials (visuals.py manifest format). The real robot: white shells, dark grey joints and grippers, brushed
 # aluminium tripod, black pads, eyes and antenna rods.
@@ -522,8 +521,7 @@ def main() -> None:
     print(f"alignment: max drift {drift_m:.1e} m, {math.degrees(drift_rad):.1e} deg over random arm/neck poses")
     baked = bake(args.source, sm, visual, boxes, om)
     files = merge_files(baked)
-    with tempfile.TemporaryDirectory(dir=OUT_DIR.parent) as tmp:
-        staging = Path(tmp)
+    with common.staged_group("reachy2", MAX_BYTES) as staging:
         for name, piece in files.items():
             common.write_stl(staging / name, piece.vertices, piece.faces)
         (staging / "visuals.json").write_text(manifest_text(manifest(baked)))
@@ -536,14 +534,8 @@ def main() -> None:
                             "LICENSE-reachy2_mujoco.txt), baked into the body frames of lerobot_tavis's Reachy2 and "
                             "decimated by `tools/assets/reachy2.py`, which regenerates every file here.",
                             rows)
-        OUT_DIR.mkdir(parents=True, exist_ok=True)
-        for old in OUT_DIR.iterdir():
-            old.unlink()
-        for new in staging.iterdir():
-            new.rename(OUT_DIR / new.name)
     triangles = sum(len(files[e["file"]].faces) for e in manifest(baked)["meshes"])
-    size = sum(f.stat().st_size for f in OUT_DIR.iterdir())
-    print(f"wrote {len(files)} meshes to {OUT_DIR}: {triangles} triangles drawn, {size / 1e6:.2f} MB")
+    print(f"{len(files)} meshes, {triangles} triangles drawn")
 
 
 if __name__ == "__main__":

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import shutil
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -37,13 +36,12 @@ import trimesh
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import (  # noqa: E402
-    PACKAGE_ASSETS, Provenance, decimate, read_git_file, write_notice, write_obj, write_texture)
+    Provenance, decimate, read_git_file, staged_group, write_notice, write_obj, write_texture)
 
 from lerobot_tavis.envs.objects import YCB_OBJECTS, PropSpec  # noqa: E402
 
 REPOSITORY = "github.com/vikashplus/YCB_sim"
 COMMIT = "57546b87f4724c947eadd4241a7892473febb88d"
-OUT_DIR = PACKAGE_ASSETS / "ycb"
 LICENSE_FILE = "LICENSE-YCB_sim.txt"
 MAX_BYTES = 6_000_000  # the whole group
 BOX_CORNER_M = 0.002  # rounding of a box mesh's vertical edges: 0.8 mm inside the box's corners
@@ -231,32 +229,24 @@ def main() -> None:
     check_commit(args.source)
     if set(POSES) != set(YCB_OBJECTS):
         raise SystemExit(f"POSES {sorted(POSES)} must name exactly the YCB props {sorted(YCB_OBJECTS)}")
-    staging = OUT_DIR.with_name(OUT_DIR.name + ".tmp")
-    shutil.rmtree(staging, ignore_errors=True)
-    staging.mkdir(parents=True)
-    entries = []
-    for name, pose in POSES.items():
-        vertices, faces, wedge_uv, texture = build(args.source, YCB_OBJECTS[name], pose)
-        write_obj(staging / f"{name}.obj", vertices, faces, wedge_uv)
-        write_texture(staging / f"{name}.png", texture)
-        print(f"{name}: {len(faces)} triangles, extents (mm) {np.ptp(vertices, axis=0) * 1000}")
-        extents = " x ".join(f"{e * 1000:.2f}" for e in primitive_extents(YCB_OBJECTS[name]))
-        changes = (f"turned upright (label towards -x), centred, scaled per axis and its outline warped onto the "
-                   f"collision shape ({extents} mm), decimated from 16,384 to {len(faces)} triangles, "
-                   "written as OBJ")
-        entries += [
-            Provenance(f"{name}.obj", REPOSITORY, COMMIT, f"meshes/{pose.source_id}.msh", LICENSE, changes),
-            Provenance(f"{name}.png", REPOSITORY, COMMIT, f"textures/{pose.source_id}.png", LICENSE,
-                       "atlas background filled with the nearest chart's colours, shrunk from 4096 to 1024 px"),
-        ]
-    (staging / LICENSE_FILE).write_bytes(read_git_file(args.source, COMMIT, "LICENSE"))
-    write_notice(staging, "YCB objects", INTRO, entries)
-    total = sum(p.stat().st_size for p in staging.iterdir())
-    if total > MAX_BYTES:
-        raise SystemExit(f"the ycb assets take {total / 1e6:.2f} MB, over the {MAX_BYTES / 1e6:.0f} MB budget")
-    shutil.rmtree(OUT_DIR, ignore_errors=True)
-    staging.rename(OUT_DIR)
-    print(f"wrote {OUT_DIR} ({total / 1e6:.2f} MB)")
+    with staged_group("ycb", MAX_BYTES) as staging:
+        entries = []
+        for name, pose in POSES.items():
+            vertices, faces, wedge_uv, texture = build(args.source, YCB_OBJECTS[name], pose)
+            write_obj(staging / f"{name}.obj", vertices, faces, wedge_uv)
+            write_texture(staging / f"{name}.png", texture)
+            print(f"{name}: {len(faces)} triangles, extents (mm) {np.ptp(vertices, axis=0) * 1000}")
+            extents = " x ".join(f"{e * 1000:.2f}" for e in primitive_extents(YCB_OBJECTS[name]))
+            changes = (f"turned upright (label towards -x), centred, scaled per axis and its outline warped onto the "
+                       f"collision shape ({extents} mm), decimated from 16,384 to {len(faces)} triangles, "
+                       "written as OBJ")
+            entries += [
+                Provenance(f"{name}.obj", REPOSITORY, COMMIT, f"meshes/{pose.source_id}.msh", LICENSE, changes),
+                Provenance(f"{name}.png", REPOSITORY, COMMIT, f"textures/{pose.source_id}.png", LICENSE,
+                           "atlas background filled with the nearest chart's colours, shrunk from 4096 to 1024 px"),
+            ]
+        (staging / LICENSE_FILE).write_bytes(read_git_file(args.source, COMMIT, "LICENSE"))
+        write_notice(staging, "YCB objects", INTRO, entries)
 
 
 LICENSE = "CC BY 4.0 (YCB models); Apache-2.0 (YCB_sim)"
