@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from lerobot_tavis.dataset_tools.features import STORAGES
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 from lerobot_tavis.errors import TavisError
 
@@ -67,8 +68,8 @@ def _convert(args: argparse.Namespace) -> None:
         raise ValueError("give exactly one of RAW_DIR (a `tavis record` output) and --from-tavis ROOT")
     image_size = _image_size(args.image_size) if args.image_size else None
     if args.from_tavis:
-        if args.zero_neck:
-            raise ValueError("--zero-neck applies to raw episodes, not to --from-tavis")
+        if args.zero_neck or args.storage != "av1":
+            raise ValueError("--zero-neck and --storage apply to raw episodes, not to --from-tavis")
         from lerobot_tavis.dataset_tools.from_tavis import convert_from_tavis
 
         root = convert_from_tavis(Path(args.from_tavis), args.repo_id, Path(args.root), fps=args.fps,
@@ -78,7 +79,8 @@ def _convert(args: argparse.Namespace) -> None:
 
         root = convert(ConvertConfig(raw_dir=Path(args.raw_dir), repo_id=args.repo_id, root=Path(args.root),
                                      fps=args.fps, image_size=image_size or (480, 640), cameras=args.cameras,
-                                     task=args.task, overwrite=args.overwrite, zero_neck=args.zero_neck))
+                                     task=args.task, overwrite=args.overwrite, zero_neck=args.zero_neck,
+                                     storage=args.storage))
     print(root)
 
 
@@ -187,6 +189,9 @@ def build_parser() -> argparse.ArgumentParser:
     conv.add_argument("--cameras", default="head,fixed,left_wrist,right_wrist", help="comma list of cameras")
     conv.add_argument("--task", help="convert only this task")
     conv.add_argument("--overwrite", action="store_true", help="replace an existing destination")
+    conv.add_argument("--storage", default="av1", choices=STORAGES,
+                      help="camera frames as AV1 video (LeRobot's default, smallest), all-intra H.264 video (fast "
+                           "random access for training) or PNG images (no video decoding; largest)")
     conv.add_argument("--zero-neck", action="store_true",
                       help="neck dims of state and action = 0 (datasets for the fixed-camera presets)")
     conv.set_defaults(run=_convert)

@@ -43,6 +43,7 @@ class ConvertConfig:
     task: str | None = None
     overwrite: bool = False
     zero_neck: bool = False  # neck dims of state and action set to 0: fixed-camera training (reference §9)
+    storage: str = "av1"  # how frames are stored: features.STORAGES
 
 
 def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
@@ -63,11 +64,12 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     if damaged:
         listing = ", ".join(f"{file} ({problem})" for file, problem in damaged.items())
         raise RawEpisodeError(f"{cfg.raw_dir}: damaged raw episodes, nothing converted: {listing}")
-    features = ft.dataset_features(make_robot(manifest.robot).joint_names(), cameras, cfg.image_size)
+    features = ft.dataset_features(make_robot(manifest.robot).joint_names(), cameras, cfg.image_size, cfg.storage)
     deviations = {}
     with staged_directory(cfg.root, overwrite=cfg.overwrite) as staging:
         dataset = LeRobotDataset.create(cfg.repo_id, fps=cfg.fps, features=features, root=staging,
-                                        robot_type=manifest.robot, use_videos=True, video_backend="pyav")
+                                        robot_type=manifest.robot, use_videos=cfg.storage != "png",
+                                        video_backend="pyav", rgb_encoder=ft.video_encoder(cfg.storage))
         replayer = Replayer(cameras, cfg.image_size, stride, cfg.zero_neck)
         try:
             for entry in tqdm(entries, desc=f"convert {cfg.repo_id}", unit="ep", disable=not progress):
@@ -79,7 +81,7 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
         finally:
             replayer.close()
             dataset.finalize()  # also on failure: an unfinalized dataset writes into the staging folder later
-        log = {"raw_dir": str(Path(cfg.raw_dir).absolute()), "fps": cfg.fps, "stride": stride,
+        log = {"raw_dir": str(Path(cfg.raw_dir).absolute()), "fps": cfg.fps, "stride": stride, "storage": cfg.storage,
                "image_size": list(cfg.image_size), "cameras": list(cameras), "zero_neck": cfg.zero_neck,
                "episodes": [{"episode_index": i, "raw_file": e.file, "task": e.task, "seed": e.seed,
                              "max_qpos_deviation": deviations[e.file]} for i, e in enumerate(entries)]}

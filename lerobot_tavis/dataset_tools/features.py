@@ -2,7 +2,8 @@
 
 Per frame (20 Hz by default):
 
-- `observation.images.<camera>`: video, (H, W, 3), cameras `head`, `fixed`, `left_wrist`, `right_wrist`
+- `observation.images.<camera>`: video (or PNG images, see STORAGES), (H, W, 3), cameras `head`, `fixed`,
+  `left_wrist`, `right_wrist`
 - `observation.state`: float32 (19,), the measured canonical state (`lerobot_tavis.canonical`, same layout as action)
 - `observation.joint_pos`: float32 (J,), the robot's joints (names from the robot)
 - `action`: float32 (19,), the canonical action taken from this frame's observation
@@ -23,6 +24,11 @@ TASK_NAME_KEY = "task_name"
 SPLIT_KEY = "split"
 IMAGE_NAMES = ["height", "width", "channels"]
 
+# How camera frames are stored. Training reads frames at random: an AV1 frame is decoded from its keyframe (every
+# second frame) with a slow software decoder; all-intra H.264 decodes each frame alone and fast; PNG images need no
+# video decoder at all but take several times the disk.
+STORAGES = ("av1", "h264", "png")
+
 
 def image_key(camera: str) -> str:
     return f"observation.images.{camera}"
@@ -37,6 +43,21 @@ def parse_cameras(text: str | Sequence[str]) -> tuple[str, ...]:
     return cameras
 
 
+def check_storage(storage: str) -> str:
+    if storage not in STORAGES:
+        raise ValueError(f"storage must be one of {STORAGES}, got {storage!r}")
+    return storage
+
+
+def video_encoder(storage: str):
+    """LeRobot's RGB encoder settings for a video storage (None: LeRobot's default, AV1 with a keyframe every 2)."""
+    from lerobot.configs.video import RGBEncoderConfig
+
+    if check_storage(storage) == "h264":
+        return RGBEncoderConfig(vcodec="h264", g=1, crf=18, preset="veryfast", fast_decode=1)
+    return None
+
+
 def frame_stride(source_fps: int, fps: int) -> int:
     """Source frames per dataset frame when a `source_fps` recording becomes an `fps` dataset (fps must divide it)."""
     if not (isinstance(fps, int) and 0 < fps <= source_fps and source_fps % fps == 0):
@@ -46,10 +67,11 @@ def frame_stride(source_fps: int, fps: int) -> int:
 
 
 def dataset_features(joint_names: Sequence[str], cameras: Sequence[str],
-                     image_size: tuple[int, int]) -> dict[str, dict]:
+                     image_size: tuple[int, int], storage: str = "av1") -> dict[str, dict]:
     """The `features` argument of `LeRobotDataset.create` for a TAVIS dataset."""
     height, width = image_size
-    features = {image_key(camera): {"dtype": "video", "shape": (height, width, 3), "names": IMAGE_NAMES}
+    dtype = "image" if check_storage(storage) == "png" else "video"
+    features = {image_key(camera): {"dtype": dtype, "shape": (height, width, 3), "names": IMAGE_NAMES}
                 for camera in parse_cameras(cameras)}
     features[STATE_KEY] = {"dtype": "float32", "shape": (canonical.ACTION_DIM,), "names": list(canonical.ACTION_NAMES)}
     features[JOINT_POS_KEY] = {"dtype": "float32", "shape": (len(joint_names),), "names": list(joint_names)}
