@@ -185,3 +185,29 @@ def test_lerobot_merges_converted_datasets(raw_dir, tmp_path):
     dataset = LeRobotDataset("local/merged", root=merged, video_backend="pyav")
     assert dataset.num_episodes == 4
     assert {dataset[0]["task_name"], dataset[len(dataset) - 1]["task_name"]} == {"peeking_box", "occluded_reach"}
+
+
+@pytest.mark.parametrize("storage", ["h264", "png"])
+def test_other_frame_storages_hold_the_same_frames(raw_dir, dataset, tmp_path, storage):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    root = tmp_path / storage
+    main(["convert", str(raw_dir), "--repo-id", f"local/{storage}", "--root", str(root), "--image-size", "48x64",
+          "--cameras", "head,fixed,left_wrist,right_wrist", "--task", "peeking_box", "--storage", storage])
+    other = LeRobotDataset(f"local/{storage}", root=root, video_backend="pyav")
+    key = image_key("fixed")
+    assert other.meta.features[key]["dtype"] == ("image" if storage == "png" else "video")
+    assert json.loads((root / "meta" / "tavis_conversion.json").read_text())["storage"] == storage
+    reference = [i for i in range(len(dataset)) if dataset[i]["task_name"] == "peeking_box"]
+    assert len(other) == len(reference)
+    for i in (0, len(other) // 2, len(other) - 1):
+        frame, expected = other[i], dataset[reference[i]]
+        np.testing.assert_array_equal(frame[ACTION_KEY].numpy(), expected[ACTION_KEY].numpy())
+        # lossless PNG and near-lossless H.264 against AV1 at crf 30: the same picture up to compression noise
+        assert np.abs(frame[key].numpy() - expected[key].numpy()).mean() < 0.03
+
+
+def test_storage_is_checked(raw_dir, tmp_path):
+    with pytest.raises(ValueError, match="storage must be one of"):
+        convert(ConvertConfig(raw_dir=raw_dir, repo_id="local/x", root=tmp_path / "x", storage="mpeg2"))
+    assert not (tmp_path / "x").exists()
