@@ -116,9 +116,9 @@ class TavisEnv(gym.Env):
         self.task_description = self._task.prompt
         mujoco.mj_forward(sim.model, sim.data)
         self._settle(sim)
+        self._steps = 0
         if self.split == "ood_init_pose":
             self._warm_up(sim)
-        self._steps = 0
         return self._observe(sim), {"is_success": False}
 
     def step(self, action):
@@ -191,12 +191,16 @@ class TavisEnv(gym.Env):
 
     def _warm_up(self, sim: _Sim) -> None:
         """ood_init_pose (reference §6): hold the rest action perturbed by Gaussian noise (0.10 m per hand axis,
-        0.175 rad on head pitch and yaw, drawn from the episode's generator) for 10 policy steps. These steps
-        happen before the first observation and do not count toward the episode length."""
+        0.175 rad on head pitch and yaw, drawn from the episode's generator) for 10 policy steps (0.5 s) before the
+        first observation. As in the reference, they count toward the episode (a 20 s episode leaves 390 policy
+        steps) and toward the task's clock (wait_then_act's light)."""
         action = warm_up_action(self.np_random)
         sim.controller.set_command(action)
-        for _ in range(WARM_UP_STEPS * physics.TICKS_PER_STEP):
-            sim.advance_tick()
+        for _ in range(WARM_UP_STEPS * physics.TICKS_PER_STEP // self._ticks_per_step):
+            for _ in range(self._ticks_per_step):
+                sim.advance_tick()
+            self._steps += 1
+            self._task.after_step(sim.model, sim.data, self._steps / self.fps)
 
     def _observe(self, sim: _Sim) -> dict:
         self._last_frames = sim.rig.render(sim.data)

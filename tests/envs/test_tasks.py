@@ -228,7 +228,35 @@ def test_ood_init_pose_starts_from_the_id_scene_with_a_perturbed_robot(small_env
     assert nominal.task_description == perturbed.task_description
     hands = [0, 1, 2, 7, 8, 9]
     moved = np.abs(ood_obs["agent_pos"][hands] - id_obs["agent_pos"][hands])
-    assert moved.max() > 0.02 and perturbed._steps == 0
+    assert moved.max() > 0.02
+
+
+def _steps_until(env, seed, done) -> int:
+    env.reset(seed=seed)
+    for step in range(1, 1000):
+        _, _, terminated, truncated, _ = env.step(canonical.rest_action())
+        if done(env, truncated):
+            return step
+    raise AssertionError("never done")
+
+
+@pytest.mark.parametrize("fps", [20, 60])
+def test_ood_init_pose_warm_up_counts_toward_the_episode_and_the_task_clock(small_env, fps):
+    def truncated(env, truncated):
+        return truncated
+
+    def green(env, truncated):
+        return env.task_object.is_green
+
+    warm_up_steps = fps // 2  # 10 policy steps at 20 Hz: 0.5 s
+    lengths = {split: _steps_until(small_env(task="clutter_pick_lift", split=split, episode_length_s=2.0, fps=fps,
+                                             camera_mode="fixedcam", cameras=()), 3, truncated)
+               for split in ("id", "ood_init_pose")}
+    assert lengths == {"id": 2 * fps, "ood_init_pose": 2 * fps - warm_up_steps}
+    greens = {split: _steps_until(small_env(task="wait_then_act", split=split, fps=fps, camera_mode="fixedcam",
+                                            cameras=()), 4, green)
+              for split in ("id", "ood_init_pose")}
+    assert greens["id"] - greens["ood_init_pose"] == warm_up_steps
 
 
 def test_task_metadata_is_readable_without_a_simulator():
