@@ -63,7 +63,9 @@ class Reachy2(Robot):
     ik_orientation_cost = 0.2
     gripper = GripperGeometry(stroke_m=0.105, palm_length_m=0.05, palm_half_width_m=0.072,
                               finger_length_m=0.06, pad_length_m=0.035, mount_offset_m=0.02)
-    head_camera = CameraMount(pos=(0.065, 0.0, 0.062), look_at=(1.065, 0.0, 0.062), up=(0.0, 0.0, 1.0),
+    # The reference's mount, inside the real head's shell: the face plate 37 mm ahead lies within the cameras'
+    # near clip (physics.NEAR_CLIP_M), so the camera sees through it, as the reference's (0.15 m clip) does.
+    head_camera = CameraMount(pos=(0.02, 0.0, 0.05), look_at=(1.02, 0.0, 0.05), up=(0.0, 0.0, 1.0),
                               hfov_deg=HEAD_HFOV_DEG)
     wrist_camera = parts.wrist_camera_mount(height_m=0.10, back_m=0.01, look_depth_m=0.146, hfov_deg=WRIST_HFOV_DEG)
 
