@@ -13,7 +13,8 @@ from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.robots import make_robot
 from lerobot_tavis.envs.tasks import multi_shelf_scan, peeking_box
 from lerobot_tavis.envs.tasks.catalog import SUITES, TASKS, suite_tasks
-from lerobot_tavis.envs.tasks.layout import required_distance
+from lerobot_tavis.envs.tasks.clutter_pick_lift import footprint
+from lerobot_tavis.envs.tasks.layout import CONTACT_GAP_M, Pose2D, overlaps
 from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.world import build_world
 
@@ -54,9 +55,9 @@ def test_suites_hold_the_reference_tasks():
 
 @pytest.mark.parametrize("variant", VARIANTS)
 @pytest.mark.parametrize("task_name", ["clutter_pick_lift", "clutter_pick_cube", "blocked_clutter_pick_cube"])
-def test_clutter_layouts_stay_in_range_and_separated(task_name, variant):
+def test_clutter_layouts_stay_in_range_and_never_overlap(task_name, variant):
     task, model, data = _world(task_name, variant)
-    region, min_sep = task.variant.region, task.variant.min_separation_m
+    region = task.variant.region
     rng = np.random.default_rng(0)
     for _ in range(SEEDS):
         task.initialize_episode(model, data, rng)
@@ -64,10 +65,16 @@ def test_clutter_layouts_stay_in_range_and_separated(task_name, variant):
         assert len(names) == 5  # cube tasks: four YCB objects and the cube
         for name in names:
             assert region.contains(_xy(model, data, name))
+        poses = {name: Pose2D(_xy(model, data, name), _yaw(model, data, name)) for name in names}
         for a, b in itertools.combinations(names, 2):
-            distance = np.linalg.norm(_xy(model, data, a) - _xy(model, data, b))
-            assert distance > required_distance(min_sep, PROPS[a].footprint_radius_m, PROPS[b].footprint_radius_m)
+            assert not overlaps(poses[a].xy[None], np.array([poses[a].yaw]), footprint(PROPS[a]), poses[b],
+                                footprint(PROPS[b]), CONTACT_GAP_M - 1e-6)[0], (a, b)
         assert task.target in names
+
+
+def _yaw(model, data, body):
+    w, x, y, z = data.qpos[model.jnt_qposadr[model.body(body).jntadr[0]] + 3:][:4]
+    return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
 
 
 @pytest.mark.parametrize("variant", VARIANTS)

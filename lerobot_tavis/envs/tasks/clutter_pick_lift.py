@@ -7,10 +7,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from lerobot_tavis.envs import placement
-from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
+from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS, PropSpec
 from lerobot_tavis.envs.tasks.base import YcbTask
 from lerobot_tavis.envs.tasks.catalog import LIFT_PROMPTS, TASKS
-from lerobot_tavis.envs.tasks.layout import Box2D, sample_separated
+from lerobot_tavis.envs.tasks.layout import Box2D, Footprint, sample_layout
 
 
 @dataclass(frozen=True)
@@ -25,12 +25,18 @@ CLUTTER_VARIANTS = {
 }
 
 
+def footprint(prop: PropSpec) -> Footprint:
+    """The outline of an upright prop seen from above."""
+    if prop.shape == "cylinder":
+        return Footprint(radius_m=prop.size_m[0] / 2)
+    return Footprint(half_xy_m=(prop.size_m[0] / 2, prop.size_m[1] / 2))
+
+
 def scatter(model, data, rng: np.random.Generator, variant: ClutterVariant, names: tuple[str, ...]) -> None:
-    """Place `names` upright at separated positions with random yaw, in the given order."""
-    positions = sample_separated(rng, variant.region, [PROPS[n].footprint_radius_m for n in names],
-                                 variant.min_separation_m)
-    for name, (x, y) in zip(names, positions):
-        placement.place_on_table(model, data, name, x, y, rng.uniform(-np.pi, np.pi))
+    """Place `names` upright, in the given order, as the reference's sampler does (`layout.sample_layout`)."""
+    poses = sample_layout(rng, variant.region, [footprint(PROPS[n]) for n in names], variant.min_separation_m)
+    for name, pose in zip(names, poses):
+        placement.place_on_table(model, data, name, *pose.xy, pose.yaw)
 
 
 class ClutterPickLift(YcbTask):
