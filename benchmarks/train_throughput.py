@@ -34,8 +34,9 @@ def dataset_root(work: Path, storage: str, image_size: str) -> Path:
 
 def make_data(work: Path, episodes: int, workers: int, storages: list[str], cameras: str, image_size: str) -> None:
     tavis = [sys.executable, "-m", "lerobot_tavis.cli"]
-    subprocess.run([*tavis, "record", "--robot", ROBOT, "--tasks", TASK, "--episodes-per-task", str(episodes),
-                    "--workers", str(workers), "--out", str(work / "raw")], check=True)
+    if not (work / "raw" / "manifest.json").exists():  # one recording serves every storage and image size
+        subprocess.run([*tavis, "record", "--robot", ROBOT, "--tasks", TASK, "--episodes-per-task", str(episodes),
+                        "--workers", str(workers), "--out", str(work / "raw")], check=True)
     converts = [subprocess.Popen([*tavis, "convert", str(work / "raw"), "--repo-id", f"local/tp-{storage}",
                                   "--root", str(dataset_root(work, storage, image_size)), "--image-size", image_size,
                                   "--cameras", cameras, "--storage", storage, "--overwrite"])
