@@ -80,7 +80,7 @@ def _convert(args: argparse.Namespace) -> None:
         root = convert(ConvertConfig(raw_dir=Path(args.raw_dir), repo_id=args.repo_id, root=Path(args.root),
                                      fps=args.fps, image_size=image_size or (480, 640), cameras=args.cameras,
                                      task=args.task, overwrite=args.overwrite, zero_neck=args.zero_neck,
-                                     storage=args.storage))
+                                     storage=args.storage, workers=args.workers))
     print(root)
 
 
@@ -194,6 +194,8 @@ def build_parser() -> argparse.ArgumentParser:
                            "random access for training) or PNG images (no video decoding; largest)")
     conv.add_argument("--zero-neck", action="store_true",
                       help="neck dims of state and action = 0 (datasets for the fixed-camera presets)")
+    conv.add_argument("--workers", type=int, default=1,
+                      help="processes replaying and rendering episodes (the dataset does not depend on it)")
     conv.set_defaults(run=_convert)
 
     push = commands.add_parser("push", help="upload a converted dataset to the Hugging Face Hub, with its card")

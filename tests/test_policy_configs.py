@@ -13,7 +13,7 @@ from lerobot_tavis import canonical
 from lerobot_tavis.cli import main
 from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
 from lerobot_tavis.dataset_tools.record import RecordConfig, record
-from lerobot_tavis.policy_configs import build_preset, preset_names, preset_path
+from lerobot_tavis.policy_configs import build_preset, preset_names, preset_path, presets
 
 TINY = (48, 64)
 # Small enough for a CPU: the preset's network shrunk, 1-second episodes, two denoising steps.
@@ -39,12 +39,13 @@ def _parse(name, *overrides):
 
 
 def test_the_shipped_files_are_the_generated_presets():
-    assert len(preset_names()) == 8
-    for name in preset_names():
-        policy, mode = name.split("_", 1)
-        assert json.loads(preset_path(name).read_text()) == build_preset(policy, mode), name
+    assert len(preset_names()) == 10
+    for name, (policy, mode, compact) in presets().items():
+        assert json.loads(preset_path(name).read_text()) == build_preset(policy, mode, compact), name
     with pytest.raises(ValueError, match="unknown preset"):
         preset_path("act_headcam")
+    with pytest.raises(ValueError, match="compact presets exist for"):
+        build_preset("diffusion", "headcam", compact=True)
 
 
 @pytest.mark.parametrize("name", preset_names())
@@ -53,9 +54,9 @@ def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_r
     from lerobot.utils.feature_utils import dataset_to_policy_features
 
     cfg = _parse(name, "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}")
-    policy, mode = name.split("_", 1)
+    policy, mode, compact = presets()[name]
     assert cfg.policy.type == policy and cfg.env.type == "tavis" and cfg.env.camera_mode == mode
-    assert (cfg.policy.n_action_steps, cfg.batch_size) == (8, 16)
+    assert (cfg.policy.n_action_steps, cfg.batch_size) == (8, 64 if compact else 16)
     dataset_features = dataset_to_policy_features(LeRobotDatasetMetadata("local/tiny", root=dataset_root).features)
     env_keys = set(cfg.env.features_map.values())
     for key, feature in cfg.policy.input_features.items():
@@ -66,7 +67,11 @@ def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_r
         {"left_wrist", "right_wrist"} if mode.endswith("wrist") else set())
     if policy == "diffusion":
         assert (cfg.policy.n_obs_steps, cfg.policy.horizon, cfg.policy.optimizer_lr) == (2, 16, 1e-4)
-        assert tuple(cfg.policy.resize_shape) == (240, 320) and cfg.policy.pretrained_backbone_weights is None
+        size = (120, 160) if compact else (240, 320)
+        assert tuple(cfg.policy.resize_shape) == size == tuple(cfg.env.image_size)
+        assert cfg.policy.pretrained_backbone_weights is None
+        assert cfg.policy.use_group_norm is not compact and cfg.policy.noise_scheduler_type == (
+            "DDIM" if compact else "DDPM")
     else:
         assert (cfg.policy.chunk_size, cfg.policy.optimizer_lr) == (16, 2.5e-5)
         assert str(cfg.policy.pretrained_path) == "lerobot/pi0_base"

@@ -4,6 +4,8 @@ Each raw episode is replayed from its seed with its recorded 60 Hz actions. Ever
 frame: the observation at that step (images, measured canonical state, joint positions) with the action taken from
 it. The replay must end as the recording did (success and length), else the conversion stops with an error; the
 largest joint-state deviation from the recorded states is kept per episode in `meta/tavis_conversion.json`.
+`workers` processes replay and render episodes side by side; this process writes them in a fixed order (task, then
+seed), so the dataset does not depend on the number of workers. Videos are encoded while frames arrive.
 The dataset is written beside its destination and moved into place only when complete.
 """
 
@@ -11,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections import deque
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +25,7 @@ from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
 from lerobot_tavis.dataset_tools.staging import staged_directory
+from lerobot_tavis.dataset_tools.workers import executor
 from lerobot_tavis.envs.tasks.catalog import task_sort_key
 from lerobot_tavis.errors import TavisError
 
@@ -44,6 +48,7 @@ class ConvertConfig:
     overwrite: bool = False
     zero_neck: bool = False  # neck dims of state and action set to 0: fixed-camera training (reference §9)
     storage: str = "av1"  # how frames are stored: features.STORAGES
+    workers: int = 1  # replaying processes
 
 
 def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
@@ -67,19 +72,20 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     features = ft.dataset_features(make_robot(manifest.robot).joint_names(), cameras, cfg.image_size, cfg.storage)
     deviations = {}
     with staged_directory(cfg.root, overwrite=cfg.overwrite) as staging:
+        videos = cfg.storage != "png"
         dataset = LeRobotDataset.create(cfg.repo_id, fps=cfg.fps, features=features, root=staging,
-                                        robot_type=manifest.robot, use_videos=cfg.storage != "png",
-                                        video_backend="pyav", rgb_encoder=ft.video_encoder(cfg.storage))
-        replayer = Replayer(cameras, cfg.image_size, stride, cfg.zero_neck)
+                                        robot_type=manifest.robot, use_videos=videos, video_backend="pyav",
+                                        rgb_encoder=ft.video_encoder(cfg.storage), streaming_encoding=videos)
+        episodes = replayed(cfg, entries, cameras, stride)
         try:
-            for entry in tqdm(entries, desc=f"convert {cfg.repo_id}", unit="ep", disable=not progress):
-                episode = load_episode(Path(cfg.raw_dir) / entry.file, entry.sha256)
-                for frame in replayer.frames(episode):
+            for entry, frames, deviation in tqdm(episodes, total=len(entries), desc=f"convert {cfg.repo_id}",
+                                                 unit="ep", disable=not progress):
+                for frame in frames:
                     dataset.add_frame(frame)
                 dataset.save_episode()
-                deviations[entry.file] = replayer.max_deviation
+                deviations[entry.file] = deviation
         finally:
-            replayer.close()
+            episodes.close()  # stops the workers at once when a replay or a write failed
             dataset.finalize()  # also on failure: an unfinalized dataset writes into the staging folder later
         log = {"raw_dir": str(Path(cfg.raw_dir).absolute()), "fps": cfg.fps, "stride": stride, "storage": cfg.storage,
                "image_size": list(cfg.image_size), "cameras": list(cameras), "zero_neck": cfg.zero_neck,
@@ -87,6 +93,50 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
                              "max_qpos_deviation": deviations[e.file]} for i, e in enumerate(entries)]}
         (staging / CONVERSION_LOG).write_text(json.dumps(log, indent=1) + "\n")
     return Path(cfg.root)
+
+
+def replayed(cfg: ConvertConfig, entries: Sequence, cameras: Sequence[str],
+             stride: int) -> Iterator[tuple[object, list[dict], float]]:
+    """(entry, frames, largest joint-state deviation) of each entry, in order, replayed by `cfg.workers` processes.
+
+    At most two episodes per worker are in flight or waiting, which bounds the memory their frames take.
+    """
+    pending = deque()
+    with executor(cfg.workers) as pool:
+        try:
+            for entry in entries:
+                pending.append((entry, pool.submit(replay_episode, Path(cfg.raw_dir) / entry.file, entry.sha256,
+                                                   tuple(cameras), cfg.image_size, stride, cfg.zero_neck)))
+                if len(pending) >= 2 * cfg.workers:
+                    entry, future = pending.popleft()
+                    yield entry, *future.result()
+            while pending:
+                entry, future = pending.popleft()
+                yield entry, *future.result()
+        finally:
+            for _, future in pending:
+                future.cancel()
+            pool.shutdown(wait=True, cancel_futures=True)
+            close_replayers()  # those of this process (workers == 1); a worker's go with its process
+
+
+_REPLAYERS: dict[tuple, Replayer] = {}  # per process: (cameras, image_size, stride, zero_neck) -> its replayer
+
+
+def replay_episode(path: Path, sha256: str, cameras: tuple[str, ...], image_size: tuple[int, int], stride: int,
+                   zero_neck: bool) -> tuple[list[dict], float]:
+    """The frames of one raw episode and the replay's largest joint-state deviation (rad or m) from the recording."""
+    key = (cameras, tuple(image_size), stride, zero_neck)
+    if key not in _REPLAYERS:
+        _REPLAYERS[key] = Replayer(cameras, image_size, stride, zero_neck)
+    replayer = _REPLAYERS[key]
+    frames = list(replayer.frames(load_episode(path, sha256)))
+    return frames, replayer.max_deviation
+
+
+def close_replayers() -> None:
+    while _REPLAYERS:
+        _REPLAYERS.popitem()[1].close()
 
 
 class Replayer:

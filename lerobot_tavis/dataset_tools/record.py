@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,6 +20,7 @@ import numpy as np
 from tqdm import tqdm
 
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
+from lerobot_tavis.dataset_tools.workers import executor
 
 RECORD_FPS = 60
 
@@ -61,7 +62,7 @@ def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
     in_flight = dict.fromkeys(cfg.tasks, 0)
     seeds = {task: _free_seeds(cfg, manifest, task) for task in cfg.tasks}
     total = cfg.episodes_per_task * len(cfg.tasks)
-    with _executor(cfg.workers) as pool, tqdm(total=total, initial=sum(map(manifest.kept, cfg.tasks)),
+    with executor(cfg.workers) as pool, tqdm(total=total, initial=sum(map(manifest.kept, cfg.tasks)),
                                               desc=f"record {cfg.robot}", unit="ep", disable=not progress) as bar:
         def refill() -> None:
             for task in cfg.tasks:
@@ -151,26 +152,3 @@ def _env(robot: str, task: str, split: str):
 
         _ENVS[key] = TavisEnv(task, robot, split=split, fps=RECORD_FPS, cameras=())
     return _ENVS[key]
-
-
-class _InlineExecutor:
-    """Runs submitted calls at once in this process (workers=1: no process start-up, easy to debug)."""
-
-    def submit(self, fn, *args) -> Future:
-        future = Future()
-        future.set_result(fn(*args))
-        return future
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        return None
-
-
-def _executor(workers: int):
-    if workers == 1:
-        return _InlineExecutor()
-    import multiprocessing
-
-    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))

@@ -32,23 +32,33 @@ POLICIES = ("diffusion", "pi0")
 PI0_BASE = "lerobot/pi0_base"
 PI0_TOKENIZER = "google/paligemma-3b-pt-224"
 DIFFUSION_IMAGE_SIZE = (240, 320)
+COMPACT_IMAGE_SIZE = (120, 160)
+COMPACT_MODES = ("head_wrist", "fixed_wrist")  # the paper's headcam and fixedcam conditions (reference §9)
 PI0_IMAGE_SIZE = (480, 640)  # pi0 resizes and pads every camera to 224x224 itself
 CHUNK, EXECUTED = 16, 8
 
 
+def presets() -> dict[str, tuple[str, str, bool]]:
+    """Every preset's name -> (policy, camera mode, compact)."""
+    table = {f"{policy}_{mode}": (policy, mode, False) for policy in POLICIES for mode in CAMERA_MODES}
+    return table | {f"diffusion_{mode}_compact": ("diffusion", mode, True) for mode in COMPACT_MODES}
+
+
 def preset_names() -> list[str]:
-    return [f"{policy}_{mode}" for policy in POLICIES for mode in CAMERA_MODES]
+    return list(presets())
 
 
 def preset_path(name: str) -> Path:
     """The JSON file of preset `name` (e.g. `diffusion_headcam`)."""
-    if name not in preset_names():
+    if name not in presets():
         raise ValueError(f"unknown preset {name!r}; presets: {', '.join(preset_names())}")
     return PRESET_DIR / f"{name}.json"
 
 
-def build_preset(policy: str, camera_mode: str) -> dict:
-    """The partial TrainPipelineConfig of one preset."""
+def build_preset(policy: str, camera_mode: str, compact: bool = False) -> dict:
+    """The partial TrainPipelineConfig of one preset (`compact`: the fast diffusion baseline, not the reference's)."""
+    if compact:
+        return _compact_diffusion(camera_mode)
     image_size = DIFFUSION_IMAGE_SIZE if policy == "diffusion" else PI0_IMAGE_SIZE
     inputs = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, *image_size]}
               for camera in mode_cameras(camera_mode)}
@@ -78,12 +88,26 @@ def build_preset(policy: str, camera_mode: str) -> dict:
     }
 
 
+def _compact_diffusion(camera_mode: str) -> dict:
+    """The reference-faithful diffusion preset, made small and fast; measured in docs/training.md."""
+    if camera_mode not in COMPACT_MODES:
+        raise ValueError(f"compact presets exist for {COMPACT_MODES}, got {camera_mode!r}")
+    preset = build_preset("diffusion", camera_mode)
+    size = list(COMPACT_IMAGE_SIZE)
+    for feature in preset["policy"]["input_features"].values():
+        if feature["type"] == "VISUAL":
+            feature["shape"] = [3, *size]
+    preset["policy"] |= {"resize_shape": size, "down_dims": [256, 512, 1024], "use_group_norm": False,
+                         "noise_scheduler_type": "DDIM", "num_inference_steps": 10}
+    preset["env"]["image_size"] = size
+    return preset | {"batch_size": 64, "steps": 6000, "save_freq": 2000, "env_eval_freq": 0}
+
+
 def write_presets() -> list[Path]:
     written = []
-    for name in preset_names():
-        policy, mode = name.split("_", 1)
+    for name, (policy, mode, compact) in presets().items():
         path = preset_path(name)
-        path.write_text(json.dumps(build_preset(policy, mode), indent=2) + "\n")
+        path.write_text(json.dumps(build_preset(policy, mode, compact), indent=2) + "\n")
         written.append(path)
     return written
 

@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact Diffusion Policy -> evaluation
+# of every checkpoint (96 episodes each, Wilson intervals and GALT by `tavis report`).
+#
+#   benchmarks/train_baseline.sh data|train|eval|overfit
+#
+# Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
+# fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
+# demonstrations, as many as the reference's datasets hold per task), STEPS and SAVE_FREQ (the preset's, 6000 and
+# 2000), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), WORK (/tmp/tavis_baseline).
+#
+# - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
+#   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
+# - train: lerobot-train with the `diffusion_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
+#   libraries can be found (PyAV's bundled copy, tools/pyav_ffmpeg.sh), else with PyAV.
+# - eval: lerobot-eval on every saved checkpoint not yet evaluated (seeds from 1000), then `tavis report`.
+# - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for 1500 steps and
+#   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
+#   on points at a data or alignment bug, not at too little training.
+set -euo pipefail
+CONDITION=${CONDITION:-head_wrist}
+TASK=${TASK:-conditional_pick}
+ROBOT=${ROBOT:-gr1t2}
+EPISODES=${EPISODES:-160}
+WORKERS=${WORKERS:-$(nproc)}
+EVAL_EPISODES=${EVAL_EPISODES:-96}
+WORK=${WORK:-/tmp/tavis_baseline}
+export MUJOCO_GL=${MUJOCO_GL:-egl}
+case "$CONDITION" in
+  head_wrist) CAMERAS=head,left_wrist,right_wrist; NECK=() ;;
+  fixed_wrist) CAMERAS=fixed,left_wrist,right_wrist; NECK=(--zero-neck) ;;
+  *) echo "CONDITION must be head_wrist or fixed_wrist, got '$CONDITION'" >&2; exit 2 ;;
+esac
+SIZE=120x160
+HERE=$(cd "$(dirname "$0")" && pwd)
+
+video_backend() {  # torchcodec when it loads (with PyAV's FFmpeg if the system has none), else pyav
+  eval "$("$HERE/../tools/pyav_ffmpeg.sh" "$WORK/ffmpeg")"
+  if python3 -c "import torchcodec.decoders" 2>/dev/null; then echo torchcodec; else echo pyav; fi
+}
+
+convert() {  # convert RAW_DIR DATASET_DIR
+  tavis convert "$1" --repo-id "local/$(basename "$2")" --root "$2" --fps 20 --image-size "$SIZE" \
+    --cameras "$CAMERAS" "${NECK[@]}" --workers "$WORKERS" --overwrite
+}
+
+train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]
+  local dataset=$1 out=$2
+  shift 2
+  lerobot-train --config_path="$(tavis presets "diffusion_${CONDITION}_compact")" \
+    --dataset.repo_id="local/$(basename "$dataset")" --dataset.root="$dataset" --dataset.video_backend="$BACKEND" \
+    --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true --num_workers="$WORKERS" \
+    --log_freq=100 --output_dir="$out" "$@"
+}
+
+evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES
+  lerobot-eval --policy.path="$1/pretrained_model" --policy.device=cuda --policy.use_amp=true --env.type=tavis \
+    --env.task="$TASK" --env.robot="$ROBOT" --env.camera_mode="$CONDITION" --env.image_size="[${SIZE/x/,}]" \
+    --seed="$3" --eval.n_episodes="$4" --eval.batch_size=$(( $4 < 32 ? $4 : 32 )) --eval.use_async_envs=true \
+    --output_dir="$2"
+  tavis report "$2"
+}
+
+case "${1:-}" in
+  data)
+    [ -f "$WORK/raw/manifest.json" ] || time tavis record --robot "$ROBOT" --tasks "$TASK" \
+      --episodes-per-task "$EPISODES" --workers "$WORKERS" --out "$WORK/raw"
+    time convert "$WORK/raw" "$WORK/dataset_$CONDITION"
+    ;;
+  train)
+    BACKEND=$(video_backend)
+    time train "$WORK/dataset_$CONDITION" "$WORK/train_$CONDITION" ${STEPS:+--steps=$STEPS} \
+      ${SAVE_FREQ:+--save_freq=$SAVE_FREQ}
+    ;;
+  eval)
+    for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
+      out="$WORK/eval_$CONDITION/step_$((10#$(basename "$checkpoint")))"
+      [ -f "$out/eval_info.json" ] || time evaluate "$checkpoint" "$out" 1000 "$EVAL_EPISODES"
+    done
+    ;;
+  overfit)
+    BACKEND=$(video_backend)
+    [ -f "$WORK/overfit/raw/manifest.json" ] || tavis record --robot "$ROBOT" --tasks "$TASK" \
+      --episodes-per-task 8 --workers 8 --out "$WORK/overfit/raw"
+    python3 - "$WORK/overfit/raw/manifest.json" <<'PY'
+import json, sys
+seeds = sorted(entry["seed"] for entry in json.load(open(sys.argv[1]))["episodes"])
+if seeds != list(range(100_000, 100_008)):
+    sys.exit(f"overfit: the evaluation assumes training seeds 100000-100007, the recording kept {seeds}")
+PY
+    convert "$WORK/overfit/raw" "$WORK/overfit/dataset_$CONDITION"
+    time train "$WORK/overfit/dataset_$CONDITION" "$WORK/overfit/train_$CONDITION" --steps=1500 --save_freq=1500 \
+      --batch_size=32
+    evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/train_seeds" 100000 8
+    evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/new_seeds" 1000 8
+    ;;
+  *)
+    echo "usage: $0 data|train|eval|overfit" >&2
+    exit 2
+    ;;
+esac

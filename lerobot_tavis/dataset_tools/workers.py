@@ -1,0 +1,33 @@
+"""Process pools for the dataset tools: `workers` spawned processes, or the calling process when workers == 1."""
+
+from __future__ import annotations
+
+import multiprocessing
+from concurrent.futures import Future, ProcessPoolExecutor
+
+
+class InlineExecutor:
+    """Runs submitted calls at once in this process (workers=1: no process start-up, easy to debug)."""
+
+    def submit(self, fn, *args) -> Future:
+        future = Future()
+        future.set_result(fn(*args))
+        return future
+
+    def shutdown(self, wait: bool = True, cancel_futures: bool = False) -> None:
+        return None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
+
+
+def executor(workers: int) -> InlineExecutor | ProcessPoolExecutor:
+    """`workers` spawned processes (MuJoCo's EGL contexts and torch do not survive a fork), or inline for one."""
+    if not (isinstance(workers, int) and workers >= 1):
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    if workers == 1:
+        return InlineExecutor()
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
