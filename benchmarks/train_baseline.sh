@@ -34,9 +34,9 @@ esac
 SIZE=120x160
 HERE=$(cd "$(dirname "$0")" && pwd)
 
-video_backend() {  # torchcodec when it loads (with PyAV's FFmpeg if the system has none), else pyav
-  eval "$("$HERE/../tools/pyav_ffmpeg.sh" "$WORK/ffmpeg")"
-  if python3 -c "import torchcodec.decoders" 2>/dev/null; then echo torchcodec; else echo pyav; fi
+choose_video_backend() {  # BACKEND=torchcodec when it loads (with PyAV's FFmpeg if the system has none), else pyav
+  eval "$("$HERE/../tools/pyav_ffmpeg.sh" "$WORK/ffmpeg")"  # exports LD_LIBRARY_PATH for lerobot-train
+  if python3 -c "import torchcodec.decoders" 2>/dev/null; then BACKEND=torchcodec; else BACKEND=pyav; fi
 }
 
 convert() {  # convert RAW_DIR DATASET_DIR
@@ -68,7 +68,7 @@ case "${1:-}" in
     time convert "$WORK/raw" "$WORK/dataset_$CONDITION"
     ;;
   train)
-    BACKEND=$(video_backend)
+    choose_video_backend
     time train "$WORK/dataset_$CONDITION" "$WORK/train_$CONDITION" ${STEPS:+--steps=$STEPS} \
       ${SAVE_FREQ:+--save_freq=$SAVE_FREQ}
     ;;
@@ -79,7 +79,7 @@ case "${1:-}" in
     done
     ;;
   overfit)
-    BACKEND=$(video_backend)
+    choose_video_backend
     [ -f "$WORK/overfit/raw/manifest.json" ] || tavis record --robot "$ROBOT" --tasks "$TASK" \
       --episodes-per-task 8 --workers 8 --out "$WORK/overfit/raw"
     python3 - "$WORK/overfit/raw/manifest.json" <<'PY'

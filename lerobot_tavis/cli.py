@@ -84,6 +84,21 @@ def _convert(args: argparse.Namespace) -> None:
     print(root)
 
 
+def _verify_dataset(args: argparse.Namespace) -> None:
+    from lerobot_tavis.dataset_tools.verify import TOLERANCE_M, verify_dataset
+
+    checks = verify_dataset(Path(args.root), args.episodes)
+    for check in checks:
+        print(f"episode {check.episode_index:4d} {check.task} seed {check.seed}: hands within "
+              f"{100 * check.max_hand_error_m:.2f} cm of the recording, replay "
+              f"{'succeeds' if check.success else 'fails'}: {'ok' if check.passed else 'FAILED'}")
+    failed = [check.episode_index for check in checks if not check.passed]
+    if failed:
+        sys.exit(f"tavis verify-dataset: {len(failed)} of {len(checks)} episodes do not replay as recorded "
+                 f"(tolerance {100 * TOLERANCE_M:.1f} cm, success required): {failed}")
+    print(f"{len(checks)} episodes replay as recorded")
+
+
 def _push(args: argparse.Namespace) -> None:
     from lerobot_tavis.dataset_tools.hub import push_dataset
 
@@ -197,6 +212,12 @@ def build_parser() -> argparse.ArgumentParser:
     conv.add_argument("--workers", type=int, default=1,
                       help="processes replaying and rendering episodes (the dataset does not depend on it)")
     conv.set_defaults(run=_convert)
+
+    verify = commands.add_parser("verify-dataset", help="replay a converted dataset's actions open loop and check "
+                                 "they reproduce its recorded states (exit 1 if not)")
+    verify.add_argument("root", help="the dataset directory (a `tavis convert` output)")
+    verify.add_argument("--episodes", type=int, nargs="+", help="episode indices (default: all)")
+    verify.set_defaults(run=_verify_dataset)
 
     push = commands.add_parser("push", help="upload a converted dataset to the Hugging Face Hub, with its card")
     push.add_argument("root", help="the dataset directory (a `tavis convert` output)")

@@ -1,8 +1,13 @@
 """`tavis convert`: replay raw episodes, render the cameras and write a LeRobotDataset v3.0.
 
 Each raw episode is replayed from its seed with its recorded 60 Hz actions. Every (60 / fps)-th step becomes a
-frame: the observation at that step (images, measured canonical state, joint positions) with the action taken from
-it. The replay must end as the recording did (success and length), else the conversion stops with an error; the
+frame: the observation at that step (images, measured canonical state, joint positions) with the last 60 Hz action
+of the frame's interval, the command in force when the next frame is observed. This is the pairing the reference
+trains on (its +1 action shift, reference §9): a 20 Hz policy holds each action for three ticks, and holding the
+interval's first command instead leaves the hands lagging the recording, a few millimetres under the lift line at
+the end of a demonstration (`tavis verify-dataset` measures it).
+
+The replay must end as the recording did (success and length), else the conversion stops with an error; the
 largest joint-state deviation from the recorded states is kept per episode in `meta/tavis_conversion.json`.
 `workers` processes replay and render episodes side by side; this process writes them in a fixed order (task, then
 seed), so the dataset does not depend on the number of workers. Videos are encoded while frames arrive.
@@ -165,7 +170,8 @@ class Replayer:
             if ended_at is not None:
                 break
             if step % self.stride == 0:
-                yield self._frame(episode, rig.render(env.data), obs, action)
+                last_in_interval = episode.actions[min(step + self.stride, len(episode.actions)) - 1]
+                yield self._frame(episode, rig.render(env.data), obs, last_in_interval)
             obs, _, terminated, truncated, info = env.step(action)
             self.max_deviation = max(self.max_deviation, float(np.max(np.abs(env.data.qpos - episode.qpos[step + 1]))))
             if terminated or truncated:

@@ -8,10 +8,10 @@ the task *class* name (e.g. "ConditionalPickTask") as LeRobot's `task`. The resu
 `observation.state`, `observation.joint_pos`, `action`, `task_name`, `split`, and the prompt as LeRobot's `task`.
 
 Frame alignment. The source pairs, in its frame k, the action sent at step k with the observation measured *after*
-step k; ours pairs each observation with the action taken *from* it. With `stride = 60 / fps`, our frame j holds
-the observation of source frame s = stride * j and the action of source frame s + 1 (the next command sent after
-that observation). A source episode of n frames gives floor((n - 2) / stride) + 1 frames: the last source frame
-has no next action. (The reference's training instead reads the action `stride` frames ahead, see §9.)
+step k. With `stride = 60 / fps`, our frame j holds the observation of source frame s = stride * j and the action
+of source frame s + stride: the last of the `stride` commands sent after that observation, as the reference's
+training reads it (its +1 action shift, §9) and as `tavis convert` pairs its own recordings. A source episode of n
+frames gives floor((n - 1) / stride) frames: the last observations have no complete interval after them.
 
 Canonical state of source frame s (reference §4, §5):
 
@@ -205,7 +205,7 @@ def _episode_task(episode: dict) -> str:
 
 def _episode_frames(meta, index: int, stride: int, cameras: dict[str, str], size: tuple[int, int],
                     neck: list[int]) -> Iterator[dict]:
-    """Our frames of source episode `index`: observation of source frame s, action of frame s + 1 (module doc)."""
+    """Our frames of source episode `index`: observation of source frame s, action of frame s + stride (module doc)."""
     import cv2
     import pyarrow.parquet as pq
 
@@ -213,10 +213,10 @@ def _episode_frames(meta, index: int, stride: int, cameras: dict[str, str], size
     table = pq.read_table(meta.root / meta.get_data_file_path(index),
                           columns=["frame_index", "timestamp", SOURCE_PROMPT, *vectors],
                           filters=[("episode_index", "==", index)]).sort_by("frame_index")
-    observed = np.arange(0, table.num_rows - 1, stride)
+    observed = np.arange(0, table.num_rows - stride, stride)
     if observed.size == 0:
         return
-    table = table.take(np.concatenate([observed, observed + 1]))
+    table = table.take(np.concatenate([observed, observed + stride]))
     count = observed.size
     data = {key: _vectors(table, key) for key in vectors}
     prompts = table.column(SOURCE_PROMPT).to_pylist()[:count]

@@ -14,6 +14,9 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
   the neck dimensions of state and action are 0 in training, as the env reports and applies them in evaluation.
 - pi0 presets need `lerobot/pi0_base` and its tokenizer from the Hub or the local cache; `tavis train` checks that
   first and says what is missing.
+- Compact presets (`diffusion_head_wrist_compact`, `diffusion_fixed_wrist_compact`: the paper's two camera
+  conditions) are not the reference's: sized to train a baseline in about 15 minutes on one GPU (120x160 frames,
+  a 103 M-parameter UNet with batch norm, batch 64, 6000 steps) and to evaluate fast (DDIM, 10 denoising steps).
 
 The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
 keeps the two in step.

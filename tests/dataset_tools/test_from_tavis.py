@@ -114,9 +114,9 @@ def test_the_schema_is_ours(imported):
     assert not [key for key in meta.features if "OBS_" in key or "eef" in key or key == "language_instruction"]
 
 
-def test_frames_pair_an_observation_with_the_next_action(imported, head_source):
+def test_frames_pair_an_observation_with_the_last_command_of_its_interval(imported, head_source):
     lengths = [int(n) for n in imported.meta.episodes["length"]]
-    assert lengths == [4, 5]  # floor((n - 2) / 3) + 1 for source episodes of 13 and 14 frames
+    assert lengths == [4, 4]  # floor((n - 1) / 3) for source episodes of 13 and 14 frames
     index = 0
     for e, (task_name, prompt) in enumerate([("conditional_pick", PROMPTS["ConditionalPickTask"]),
                                              ("wait_then_act", PROMPTS["WaitThenActTask"])]):
@@ -125,8 +125,8 @@ def test_frames_pair_an_observation_with_the_next_action(imported, head_source):
             item, s = imported[index], 3 * j
             index += 1
             assert item["episode_index"].item() == e and item["frame_index"].item() == j
-            np.testing.assert_allclose(item["action"].numpy(), src["action"][s + 1])
-            assert item["action"][0].item() == s + 1 and item["action"][1].item() == e
+            np.testing.assert_allclose(item["action"].numpy(), src["action"][s + 3])
+            assert item["action"][0].item() == s + 3 and item["action"][1].item() == e
             state = item[ft.STATE_KEY].numpy()
             np.testing.assert_allclose(state[0:3], src["observation.left_eef_pos"][s])
             np.testing.assert_allclose(state[7:10], src["observation.right_eef_pos"][s])
@@ -147,12 +147,12 @@ def test_task_filter_resize_and_split(head_source, tmp_path):
     convert_from_tavis(head_source.root, "local/wait", root, fps=30, image_size=(36, 48), task="wait_then_act",
                        split="ood_spatial", progress=False)  # SVT-AV1 cannot encode much smaller than 24 x 32
     dataset = load(root, "local/wait")
-    assert dataset.meta.total_episodes == 1 and dataset.meta.fps == 30 and len(dataset) == 7  # (14 - 2) // 2 + 1
+    assert dataset.meta.total_episodes == 1 and dataset.meta.fps == 30 and len(dataset) == 6  # (14 - 1) // 2
     assert tuple(dataset.meta.features[ft.image_key("fixed")]["shape"]) == (36, 48, 3)
     item = dataset[3]
     assert tuple(item[ft.image_key("head")].shape) == (3, 36, 48)
     assert abs(item[ft.image_key("head")].mean().item() * 255 - BRIGHTNESS["OBS_HEAD"](6)) < 3
-    assert item["action"][0].item() == 7 and item["action"][1].item() == 1
+    assert item["action"][0].item() == 8 and item["action"][1].item() == 1
     assert item[ft.TASK_NAME_KEY] == "wait_then_act" and item[ft.SPLIT_KEY] == "ood_spatial"
 
 
@@ -161,7 +161,7 @@ def test_named_neck_joints_and_robot_from_the_dataset_name(reachy_source, tmp_pa
     convert_from_tavis(reachy_source.root, "local/reachy", root, fps=20, progress=False)
     dataset = load(root, "local/reachy")
     meta, src = dataset.meta, reachy_source.episodes[0]
-    assert meta.robot_type == "reachy2" and len(dataset) == 2  # (7 - 2) // 3 + 1
+    assert meta.robot_type == "reachy2" and len(dataset) == 2  # (7 - 1) // 3
     assert list(meta.camera_keys) == [ft.image_key("left_wrist")]
     assert meta.features[ft.JOINT_POS_KEY]["names"][:3] == ["neck_roll", "neck_pitch", "neck_yaw"]
     np.testing.assert_allclose(dataset[1][ft.STATE_KEY][14:17].numpy(), src["observation.state"][3, :3])

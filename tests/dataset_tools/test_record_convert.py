@@ -99,17 +99,19 @@ def _episodes_in_dataset_order(manifest):
     return sorted(manifest.episodes, key=lambda e: (HANDS.index(e.task), e.seed))
 
 
-def test_frames_pair_each_observation_with_the_recorded_action(dataset, raw_dir):
+def test_frames_pair_each_observation_with_the_last_command_of_its_interval(dataset, raw_dir):
     episodes = _episodes_in_dataset_order(raw_files.Manifest.load(raw_dir))
     start = 0
     for index, entry in enumerate(episodes):
         episode = raw_files.load_episode(raw_dir / entry.file)
-        for j in (0, 7):
+        n_frames = -(-entry.n_steps // 3)
+        for j in (0, 7, n_frames - 1):
             frame = dataset[start + j]
             assert int(frame["episode_index"]) == index and int(frame["frame_index"]) == j
-            np.testing.assert_array_equal(frame[ACTION_KEY].numpy(), episode.actions[3 * j].astype(np.float32))
+            last_tick = min(3 * j + 3, entry.n_steps) - 1  # frame j observes tick 3j; ticks 3j..3j+2 follow it
+            np.testing.assert_array_equal(frame[ACTION_KEY].numpy(), episode.actions[last_tick].astype(np.float32))
             assert frame["task"] == episode.prompt and frame["task_name"] == entry.task and frame["split"] == "id"
-        start += -(-entry.n_steps // 3)
+        start += n_frames
     first = dataset[0]
     assert first[image_key("head")].shape == (3, *IMAGE_SIZE)
     blocked = HANDS.index("blocked_clutter_pick_cube") * 2
@@ -119,12 +121,13 @@ def test_frames_pair_each_observation_with_the_recorded_action(dataset, raw_dir)
     assert [e["max_qpos_deviation"] for e in log["episodes"]] == [0.0] * 6  # exact replay
 
 
-def test_converting_twice_gives_identical_data(raw_dir, tmp_path):
+def test_converting_twice_gives_identical_data_whatever_the_workers(raw_dir, tmp_path):
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     roots = []
-    for name in ("a", "b"):
-        cfg = ConvertConfig(raw_dir, f"local/{name}", tmp_path / name, image_size=IMAGE_SIZE, task="peeking_box")
+    for name, workers in (("a", 1), ("b", 2)):
+        cfg = ConvertConfig(raw_dir, f"local/{name}", tmp_path / name, image_size=IMAGE_SIZE, task="peeking_box",
+                            workers=workers)
         roots.append(convert(cfg, progress=False))
     tables = [pd.read_parquet(root / "data") for root in roots]
     pd.testing.assert_frame_equal(*tables)
