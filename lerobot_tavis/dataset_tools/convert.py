@@ -73,7 +73,7 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     damaged = manifest.damaged(cfg.raw_dir)
     if damaged:
         listing = ", ".join(f"{file} ({problem})" for file, problem in damaged.items())
-        raise RawEpisodeError(f"{cfg.raw_dir}: damaged raw episodes, nothing converted: {listing}")
+        raise RawEpisodeError(f"{cfg.raw_dir}: raw episodes that cannot be trusted, nothing converted: {listing}")
     features = ft.dataset_features(make_robot(manifest.robot).joint_names(), cameras, cfg.image_size, cfg.storage)
     deviations = {}
     with staged_directory(cfg.root, overwrite=cfg.overwrite) as staging:

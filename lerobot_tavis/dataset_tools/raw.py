@@ -89,6 +89,15 @@ def load_episode(path: str | Path, sha256: str | None = None) -> RawEpisode:
     return episode
 
 
+def read_header(path: str | Path) -> dict:
+    """A raw file's own record of its episode (robot, task, split, seed, fps, success, n_steps), without its states."""
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            return json.loads(str(archive["metadata"])) | {"n_steps": len(archive["actions"])}
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as error:
+        raise RawEpisodeError(f"{path}: not a readable raw episode ({type(error).__name__}: {error})") from None
+
+
 def _check_shapes(path: Path, episode: RawEpisode) -> None:
     steps = episode.n_steps
     if episode.actions.ndim != 2 or episode.actions.shape[1] != canonical.ACTION_DIM or steps == 0:
@@ -98,6 +107,10 @@ def _check_shapes(path: Path, episode: RawEpisode) -> None:
         rows = len(getattr(episode, name))
         if rows != steps + 1:
             raise RawEpisodeError(f"{path}: {name} must have {steps + 1} rows (T + 1), got {rows}")
+
+
+def _content_sha256(document: dict) -> str:
+    return hashlib.sha256(json.dumps(document, sort_keys=True).encode()).hexdigest()
 
 
 def file_sha256(path: str | Path) -> str:
@@ -144,12 +157,14 @@ class Manifest:
                 for task in tasks}
 
     def save(self, raw_dir: str | Path) -> None:
+        """Write the manifest atomically, with a checksum of its own content (hand edits are detected on load)."""
         path = Path(raw_dir) / MANIFEST_NAME
         partial = path.with_name(f".{path.name}.partial")
         document = {"format": FORMAT, "version": FORMAT_VERSION, "robot": self.robot, "split": self.split,
                     "fps": self.fps, "seed_start": self.seed_start, "counts": self.counts(),
                     "episodes": [asdict(e) for e in self.episodes],
                     "discarded": [asdict(e) for e in self.discarded]}
+        document["sha256"] = _content_sha256(document)
         partial.write_text(json.dumps(document, indent=1) + "\n")
         os.replace(partial, path)
 
@@ -160,6 +175,10 @@ class Manifest:
             raise FileNotFoundError(f"{path} not found: is {raw_dir} a directory written by `tavis record`?")
         try:
             document = json.loads(path.read_text())
+            recorded = document.pop("sha256", None)
+            if recorded is not None and recorded != _content_sha256(document):
+                raise RawEpisodeError(f"{path}: changed since `tavis record` wrote it (its checksum no longer matches "
+                                      "its content); restore it or record again")
             return cls(robot=document["robot"], split=document["split"], fps=int(document["fps"]),
                        seed_start=int(document["seed_start"]),
                        episodes=[ManifestEntry(**e) for e in document["episodes"]],
@@ -168,12 +187,27 @@ class Manifest:
             raise RawEpisodeError(f"{path}: not a valid manifest ({type(error).__name__}: {error})") from None
 
     def damaged(self, raw_dir: str | Path) -> dict[str, str]:
-        """Kept episodes whose file is missing or fails its checksum: {file: problem}."""
-        problems = {}
+        """Kept episodes that cannot be trusted, {file: problem}: a missing file, a failed checksum, a second entry
+        for the same file or (task, seed), or a field where the manifest and the file's own record disagree."""
+        problems, seen = {}, set()
         for entry in self.episodes:
             path = Path(raw_dir) / entry.file
-            if not path.is_file():
+            if entry.file in seen or (entry.task, entry.seed) in seen:
+                problems[entry.file] = f"listed twice (task {entry.task}, seed {entry.seed})"
+            elif not path.is_file():
                 problems[entry.file] = "missing"
             elif file_sha256(path) != entry.sha256:
                 problems[entry.file] = "checksum mismatch"
+            else:
+                problems |= self._disagreement(path, entry)
+            seen |= {entry.file, (entry.task, entry.seed)}
         return problems
+
+    def _disagreement(self, path: Path, entry: ManifestEntry) -> dict[str, str]:
+        header = read_header(path)
+        claimed = {"robot": self.robot, "split": self.split, "fps": self.fps, "task": entry.task, "seed": entry.seed,
+                   "success": entry.success, "n_steps": entry.n_steps}
+        for field_name, value in claimed.items():
+            if header.get(field_name) != value:
+                return {entry.file: f"{field_name}: the manifest says {value!r}, the file {header.get(field_name)!r}"}
+        return {}
