@@ -32,9 +32,9 @@ from train_throughput import dataset_root
 
 def train_config(args: argparse.Namespace, extra: list[str]):
     """LeRobot's TrainPipelineConfig of the preset with the extra arguments, validated as lerobot-train does."""
-    import lerobot_tavis  # noqa: F401  (registers --env.type=tavis)
     from lerobot.configs.train import TrainPipelineConfig
 
+    import lerobot_env_tavis  # noqa: F401  (registers --env.type=tavis, as LeRobot's CLIs do)
     from lerobot_tavis.policy_configs import preset_path
 
     root = dataset_root(args.work, args.storage, args.image_size)

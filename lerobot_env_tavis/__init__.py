@@ -1,1 +1,5 @@
-import lerobot_tavis  # noqa: F401  (registers the `tavis` env type with LeRobot)
+"""The plugin module LeRobot imports in every CLI: registers `--env.type=tavis` (it loads LeRobot itself)."""
+
+from lerobot_tavis.envs.config import TavisEnvConfig
+
+__all__ = ["TavisEnvConfig"]

@@ -1,9 +1,18 @@
 """TAVIS benchmark in MuJoCo, as a LeRobot env plugin.
 
-Importing the package registers `--env.type=tavis` with LeRobot (`lerobot_tavis.envs.config`); it imports neither
-MuJoCo nor any policy or dataset code, because LeRobot imports plugins in every CLI.
+Importing the package loads neither LeRobot nor torch, so processes that only simulate stay lean. `--env.type=tavis`
+is registered with LeRobot by importing `lerobot_tavis.envs.config`, which LeRobot's CLIs do through the plugin
+module `lerobot_env_tavis` (the distribution's name: LeRobot imports it in every CLI).
 """
 
-from lerobot_tavis.envs.config import TavisEnvConfig
+
+def __getattr__(name: str):
+    """`lerobot_tavis.TavisEnvConfig`, imported (and registered with LeRobot) on first use."""
+    if name == "TavisEnvConfig":
+        from lerobot_tavis.envs.config import TavisEnvConfig
+
+        return TavisEnvConfig
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = ["TavisEnvConfig"]

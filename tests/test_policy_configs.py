@@ -35,6 +35,8 @@ def _parse(name, *overrides):
     import lerobot.policies  # noqa: F401  (registers the policy types)
     from lerobot.configs.train import TrainPipelineConfig
 
+    import lerobot_env_tavis  # noqa: F401  (registers the env type, as LeRobot's CLIs do)
+
     return draccus.parse(TrainPipelineConfig, config_path=str(preset_path(name)), args=list(overrides))
 
 

@@ -20,38 +20,12 @@ from lerobot.envs.configs import EnvConfig
 from lerobot.envs.utils import _LazyAsyncVectorEnv, freeze_after_episode_end
 
 from lerobot_tavis import canonical
+from lerobot_tavis.envs.factory import make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, mode_cameras
-from lerobot_tavis.envs.tasks.catalog import SPLITS, SUITES, suite_tasks, task_info
+from lerobot_tavis.envs.tasks.catalog import SPLITS, expand_tasks
+from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 
 ROBOT_NAMES = ("gr1t2", "reachy2")
-EPISODE_LOG_NAME = "episodes.jsonl"
-
-
-def expand_tasks(spec: str) -> dict[str, list[str]]:
-    """`tavis_head`, `peeking_box` or `tavis_head,occluded_reach` -> {suite: [task, ...]}, in the given order."""
-    groups: dict[str, list[str]] = {}
-    for item in (part.strip() for part in spec.split(",")):
-        names = suite_tasks(item) if item in SUITES else (task_info(item).name,)
-        for name in names:
-            suite = task_info(name).suite
-            if name not in groups.setdefault(suite, []):
-                groups[suite].append(name)
-    return groups
-
-
-def make_tavis_env(task: str, robot: str, camera_mode: str, split: str, image_size: tuple[int, int],
-                   episode_length_s: float, episode_log: str | None = None, suite: str = "",
-                   task_id: int = 0) -> gym.Env:
-    """One sub-env (picklable through functools.partial for forkserver workers)."""
-    from lerobot_tavis.envs.env import TavisEnv  # imports MuJoCo: only in the process that simulates
-
-    env = TavisEnv(task, robot, camera_mode=camera_mode, split=split, image_size=tuple(image_size),
-                   episode_length_s=episode_length_s)
-    if episode_log:
-        from lerobot_tavis.eval.episode_log import EpisodeLogger
-
-        env = EpisodeLogger(env, episode_log, suite=suite, task_id=task_id)
-    return env
 
 
 @EnvConfig.register_subclass("tavis")

@@ -19,6 +19,7 @@ import numpy as np
 from lerobot_tavis.envs.modes import neck_locked
 from lerobot_tavis.metrics.galt import compute_galt, wrist_lead_per_grasp
 
+EPISODE_LOG_NAME = "episodes.jsonl"  # in the output directory of a lerobot-eval or lerobot-train run
 GALT_FIELDS = ("galt_s", "galt_reason", "galt_arm", "galt_t_head_arrival_s", "galt_t_hand_arrival_s",
                "galt_t_hand_onset_s", "galt_arm_reach_s")
 WRIST_FIELDS = ("wrist_lead_s", "wrist_lead_reason", "wrist_lead_arm")

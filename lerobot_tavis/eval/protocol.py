@@ -19,7 +19,8 @@ from pathlib import Path
 from tqdm import tqdm
 
 from lerobot_tavis.dataset_tools.staging import staged_directory
-from lerobot_tavis.envs.config import EPISODE_LOG_NAME, expand_tasks
+from lerobot_tavis.envs.tasks.catalog import expand_tasks
+from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
 START_SEED = 1000
@@ -118,7 +119,7 @@ def _expert_task(job) -> list[bool]:
     """Episodes seed .. seed + n - 1 of one task with its demonstrator; returns LeRobot-style successes."""
     cfg, cell, task_id, task, log_path = job
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from lerobot_tavis.envs.config import make_tavis_env
+    from lerobot_tavis.envs.factory import make_tavis_env
     from lerobot_tavis.experts.registry import run_episode
 
     env = make_tavis_env(task, cfg.robot, cfg.camera_mode, cell.split, cfg.image_size, cfg.episode_length_s,

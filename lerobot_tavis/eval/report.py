@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_tavis.envs.config import EPISODE_LOG_NAME
 from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
+from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.metrics.stats import wilson_interval
 
 EVAL_INFO_NAME = "eval_info.json"

@@ -5,7 +5,7 @@ import pytest
 from lerobot.envs.configs import EnvConfig
 from lerobot.envs.utils import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd, _LazyAsyncVectorEnv, preprocess_observation
 
-import lerobot_tavis  # noqa: F401  (registers the env type)
+import lerobot_env_tavis  # noqa: F401  (registers the env type, as LeRobot's CLIs do)
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.config import TavisEnvConfig, expand_tasks
 from lerobot_tavis.envs.env import scene_seed

@@ -105,3 +105,15 @@ def task_info(name: str) -> TaskInfo:
         return TASKS[name]
     except KeyError:
         raise ValueError(f"task must be one of {sorted(TASKS)}, got {name!r}") from None
+
+
+def expand_tasks(spec: str) -> dict[str, list[str]]:
+    """`tavis_head`, `peeking_box` or `tavis_head,occluded_reach` -> {suite: [task, ...]}, in the given order."""
+    groups: dict[str, list[str]] = {}
+    for item in (part.strip() for part in spec.split(",")):
+        names = suite_tasks(item) if item in SUITES else (task_info(item).name,)
+        for name in names:
+            suite = task_info(name).suite
+            if name not in groups.setdefault(suite, []):
+                groups[suite].append(name)
+    return groups

@@ -1,0 +1,64 @@
+"""Footprint of a process that only simulates: import time of the env module and peak resident memory.
+
+    MUJOCO_GL=egl python benchmarks/worker_footprint.py [--task wait_then_act] [--robot gr1t2] [--repeats 3]
+                                                        [--no-render]
+
+Each measurement is a fresh Python process, as a worker of `tavis record`, `tavis eval --expert` or LeRobot's async
+vector envs is: it times `import lerobot_tavis.envs.env`, builds a TavisEnv at 96x128 (the default camera mode),
+plays one demonstrator episode and reads its peak resident memory (`ru_maxrss`). Prints one line per process, the
+medians, and whether torch or LeRobot was imported. `--no-render` builds the env with no cameras, as the workers of
+`tavis record` and `benchmarks/expert_success.py` do (no GL context).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import statistics
+import subprocess
+import sys
+import time
+
+
+def measure(task: str, robot: str, render: bool) -> dict:
+    """Runs in the fresh process: nothing but the standard library is imported before the timed import."""
+    start = time.perf_counter()
+    from lerobot_tavis.envs.env import TavisEnv
+    import_s = time.perf_counter() - start
+    from lerobot_tavis.experts.registry import run_episode
+
+    env = TavisEnv(task, robot, image_size=(96, 128), cameras=None if render else ())
+    result = run_episode(env, seed=0)
+    env.close()
+    return {"import_s": import_s, "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+            "steps": result.length_steps, "success": result.success,
+            "heavy": sorted(m for m in ("torch", "lerobot") if m in sys.modules)}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--task", default="wait_then_act")
+    parser.add_argument("--robot", default="gr1t2")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--no-render", action="store_true", help="no cameras, hence no GL context")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        print(json.dumps(measure(args.task, args.robot, render=not args.no_render)))
+        return
+    runs = []
+    for _ in range(args.repeats):
+        child = subprocess.run([sys.executable, __file__, "--child", *sys.argv[1:]], check=True, capture_output=True,
+                               text=True)
+        runs.append(json.loads(child.stdout.splitlines()[-1]))
+        print(json.dumps(runs[-1]))
+    cameras = "no cameras" if args.no_render else "96x128"
+    print(f"{args.task} / {args.robot}, {cameras}, {args.repeats} fresh processes: "
+          f"import lerobot_tavis.envs.env {statistics.median(r['import_s'] for r in runs):.2f} s, "
+          f"peak resident {statistics.median(r['peak_mib'] for r in runs):.0f} MiB (median); "
+          f"torch/lerobot imported: {runs[0]['heavy'] or 'neither'}")
+
+
+if __name__ == "__main__":
+    main()
