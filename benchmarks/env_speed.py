@@ -25,7 +25,7 @@ import subprocess
 import sys
 import time
 
-CONFIGS = [(mode, size) for mode in ("headcam", "head_wrist") for size in ((240, 320), (480, 640))]
+CONFIGS = [(mode, size) for mode in ("head_only", "head_wrist") for size in ((240, 320), (480, 640))]
 WARM_UP_STEPS = 10
 RENDER_REPEATS = 50
 
@@ -136,7 +136,7 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|---|")
     for config in configs:
         robot, mode, (h, w), shadows = config
-        print(f"| {robot} | {mode} | {h}x{w} | {1 if mode == 'headcam' else 3} | {shadows} "
+        print(f"| {robot} | {mode} | {h}x{w} | {1 if mode == 'head_only' else 3} | {shadows} "
               f"| {median(config, 'steps_per_s'):.1f} | {median(config, 'render_ms'):.2f} "
               f"| {median(config, 'reset_s'):.2f} |")
     if not peer:

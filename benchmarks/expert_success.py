@@ -33,7 +33,7 @@ def run_chunk(args: tuple[str, str, str, range]) -> tuple[str, str, str, int, in
         leads = wrist_lead_per_grasp(actions, fps=20)
         return leads[-1].lead_s if leads else None
 
-    env = TavisEnv(task, robot, camera_mode="headcam", split=split, cameras=())
+    env = TavisEnv(task, robot, camera_mode="head_only", split=split, cameras=())
     successes, leads = 0, []
     for seed in seeds:
         result = run_episode(env, seed)

@@ -81,7 +81,7 @@ def validate_action(action) -> np.ndarray:
         i = int(bad[0])
         raise ValueError(f"action[{i}] ({ACTION_NAMES[i]}) must be finite, got {array[i]}")
     for arm in ARMS:
-        if np.linalg.norm(array[arm.quaternion]) < 1e-6:
+        if np.max(np.abs(array[arm.quaternion])) < 1e-6:
             s = arm.quaternion
             raise ValueError(f"action[{s.start}:{s.stop}] ({arm.side} end-effector quaternion) has zero norm")
     return array

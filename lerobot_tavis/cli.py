@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from lerobot_tavis.dataset_tools.features import STORAGES
+from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, RENAMED_MODES
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 from lerobot_tavis.errors import TavisError
 
@@ -172,8 +173,8 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--splits", nargs="+", default=["id", "ood_spatial", "ood_init_pose"],
                           choices=["id", "ood_spatial", "ood_init_pose"])
     evaluate.add_argument("--episodes", type=int, default=96, help="episodes per task and split (default 96)")
-    evaluate.add_argument("--camera-mode", default="headcam",
-                          choices=["headcam", "fixedcam", "head_wrist", "fixed_wrist"])
+    evaluate.add_argument("--camera-mode", default=DEFAULT_CAMERA_MODE, choices=[*CAMERA_MODES, *RENAMED_MODES],
+                          help="head_wrist (default) and fixed_wrist are the paper's headcam and fixedcam conditions")
     evaluate.add_argument("--image-size", default="480x640")
     evaluate.add_argument("--batch-size", type=int, default=1, help="parallel envs per task (policy runs)")
     evaluate.add_argument("--device", default="cpu")
@@ -233,7 +234,7 @@ def build_parser() -> argparse.ArgumentParser:
     pull.set_defaults(run=_pull)
 
     presets = commands.add_parser("presets", help="list the training presets, or print the path of one")
-    presets.add_argument("name", nargs="?", help="a preset name, e.g. diffusion_headcam")
+    presets.add_argument("name", nargs="?", help="a preset name, e.g. diffusion_head_wrist")
     presets.set_defaults(run=_presets)
 
     train = commands.add_parser("train", help="lerobot-train with a preset (checks pi0 downloads first); "

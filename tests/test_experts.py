@@ -17,7 +17,7 @@ def tiny_env():
     envs = []
 
     def make(task, robot="gr1t2", **kwargs):
-        env = TavisEnv(task, robot, camera_mode="headcam", image_size=(16, 16), **kwargs)
+        env = TavisEnv(task, robot, camera_mode="head_only", image_size=(16, 16), **kwargs)
         envs.append(env)
         return env
 

@@ -47,7 +47,7 @@ def test_the_shipped_files_are_the_generated_presets():
     with pytest.raises(ValueError, match="unknown preset"):
         preset_path("act_headcam")
     with pytest.raises(ValueError, match="compact presets exist for"):
-        build_preset("diffusion", "headcam", compact=True)
+        build_preset("diffusion", "head_only", compact=True)
 
 
 @pytest.mark.parametrize("name", preset_names())
@@ -93,13 +93,14 @@ def test_zero_neck_conversion_for_the_fixed_camera_presets(dataset_root, tmp_pat
 
 def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_eval(dataset_root, tmp_path):
     env = {**os.environ, "MUJOCO_GL": "egl"}
-    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={preset_path('diffusion_headcam')}",
+    preset = preset_path("diffusion_head_only")
+    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={preset}",
              "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", *SMALL_RUN, "--steps=2",
              "--env_eval_freq=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", "--eval.n_episodes=1",
              "--eval.batch_size=1", "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'train'}"]
     subprocess.run(train, check=True, capture_output=True, env=env, timeout=600)
     (periodic,) = [json.loads(line) for line in (tmp_path / "train" / "episodes.jsonl").read_text().splitlines()]
-    assert periodic["task"] == "conditional_pick" and periodic["camera_mode"] == "headcam"
+    assert periodic["task"] == "conditional_pick" and periodic["camera_mode"] == "head_only"
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     evaluate = [sys.executable, "-m", "lerobot.scripts.lerobot_eval", f"--policy.path={checkpoint}",
                 "--policy.device=cpu", "--env.type=tavis", "--env.task=conditional_pick",
@@ -112,7 +113,7 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
 
 def test_pi0_presets_say_clearly_what_is_missing_offline(tmp_path):
     env = {**os.environ, "HF_HUB_OFFLINE": "1", "HF_HOME": str(tmp_path / "hf"), "HF_TOKEN": ""}
-    result = subprocess.run([sys.executable, "-m", "lerobot_tavis.cli", "train", "pi0_headcam", "--steps=1"],
+    result = subprocess.run([sys.executable, "-m", "lerobot_tavis.cli", "train", "pi0_head_only", "--steps=1"],
                             capture_output=True, text=True, env=env, timeout=120)
     assert result.returncode == 1
     assert "tavis train: error: pi0 needs lerobot/pi0_base" in result.stderr

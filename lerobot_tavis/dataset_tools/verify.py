@@ -79,7 +79,7 @@ def _replay(robot: str, fps: int, entry: dict, columns: dict, zero_neck: bool, h
     from lerobot_tavis.envs.env import TavisEnv
 
     states, actions = columns["state"], np.roll(columns["action"], action_shift, axis=0)
-    env = TavisEnv(entry["task"], robot, camera_mode="fixedcam" if zero_neck else "headcam",
+    env = TavisEnv(entry["task"], robot, camera_mode="fixed_only" if zero_neck else "head_only",
                    split=columns["split"], fps=fps, cameras=(), episode_length_s=len(actions) / fps + hold_s + 1)
     try:
         obs, _ = env.reset(seed=entry["seed"])

@@ -21,7 +21,7 @@ from lerobot.envs.utils import _LazyAsyncVectorEnv, freeze_after_episode_end
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.factory import make_tavis_env
-from lerobot_tavis.envs.modes import CAMERA_MODES, mode_cameras
+from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.tasks.catalog import SPLITS, expand_tasks
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 
@@ -34,7 +34,7 @@ class TavisEnvConfig(EnvConfig):
     task: str = "tavis_head"
     fps: int = 20
     robot: str = "gr1t2"
-    camera_mode: str = "headcam"
+    camera_mode: str = DEFAULT_CAMERA_MODE  # the paper's "headcam" condition: head and both wrist cameras
     split: str = "id"
     image_size: tuple[int, int] = (480, 640)
     episode_length_s: float = 20.0
@@ -46,7 +46,7 @@ class TavisEnvConfig(EnvConfig):
         expand_tasks(self.task)  # raises a clear error for an unknown task or suite
         if self.robot not in ROBOT_NAMES:
             raise ValueError(f"robot must be one of {ROBOT_NAMES}, got {self.robot!r}")
-        mode_cameras(self.camera_mode)
+        self.camera_mode = resolve_camera_mode(self.camera_mode)
         if self.split not in SPLITS:
             raise ValueError(f"split must be one of {SPLITS}, got {self.split!r}")
         if self.fps != 20:

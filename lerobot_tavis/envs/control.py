@@ -3,7 +3,8 @@
 Every 60 Hz tick the controller reads the measured arm joints, solves one damped-least-squares IK step (a frame
 task per hand, a posture task toward the home pose, joint position and velocity limits) on a robot-only copy of the
 model, and sends the integrated joint positions to the arm position servos. Neck targets are the commanded angles
-clipped to the joint ranges; gripper targets ramp toward the command at the gripper's finger speed.
+clipped to the joint ranges; gripper targets ramp toward the command at the gripper's finger speed. Any finite
+command is usable: quaternions of any size are normalised, far hand targets drawn in (`MAX_TARGET_DISTANCE_M`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,10 @@ LM_DAMPING = 0.5
 SOLVER_DAMPING = 1e-3
 ARM_SPEED_LIMIT_RAD_S = 6.0
 SOLVER = "daqp"
+# Hand targets farther than this from the canonical origin (five times the arms' reach) are moved along their
+# direction to this distance, so the IK never sees an error so large that its damped step vanishes; the hand then
+# stretches toward them as toward any far target (beyond 3 m the reached pose moves by a few cm at most).
+MAX_TARGET_DISTANCE_M = 3.0
 
 
 class ArmIK:
@@ -88,6 +93,26 @@ class ArmIK:
         return pose.translation(), pose.rotation().wxyz
 
 
+def _unit(quat: np.ndarray) -> np.ndarray:
+    """`quat` normalised without overflow for any finite size; an already normalised one is returned unchanged
+    (so that applying an applied command again changes nothing, not a bit)."""
+    with np.errstate(over="ignore"):
+        if abs(np.linalg.norm(quat) - 1.0) <= 1e-12:
+            return quat
+    scaled = quat / np.max(np.abs(quat))
+    return scaled / np.linalg.norm(scaled)
+
+
+def _within(offset: np.ndarray, radius: float) -> np.ndarray:
+    """`offset` (m, canonical frame) moved along its direction to at most `radius` from the canonical origin."""
+    scale = np.max(np.abs(offset))
+    if scale <= radius / 2:  # certainly inside, and its norm cannot overflow
+        return offset
+    direction = offset / scale
+    distance = scale * np.linalg.norm(direction)
+    return offset if distance <= radius else direction / np.linalg.norm(direction) * radius
+
+
 def hand_targets(robot: Robot, action: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """World-frame hand targets of a canonical action."""
     origin = np.asarray(robot.canonical_origin)
@@ -138,9 +163,8 @@ class Controller:
             command[canonical.HEAD] = 0.0
         for arm in canonical.ARMS:
             command[arm.gripper] = np.clip(command[arm.gripper], -1.0, 1.0)
-            norm = np.linalg.norm(command[arm.quaternion])
-            if abs(norm - 1.0) > 1e-12:  # so that applying an applied command again changes nothing, not a bit
-                command[arm.quaternion] /= norm
+            command[arm.quaternion] = _unit(command[arm.quaternion])
+            command[arm.position] = _within(command[arm.position], MAX_TARGET_DISTANCE_M)
         self.command = command
         self.ik.set_targets(hand_targets(self.robot, command))
         return command

@@ -17,7 +17,8 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.control import Controller
-from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS, mode_cameras, neck_locked
+from lerobot_tavis.envs.modes import (CAMERA_NAMES, DEFAULT_CAMERA_MODE, VIEW_CAMERAS, mode_cameras, neck_locked,
+                                      resolve_camera_mode)
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
@@ -31,6 +32,8 @@ SETTLE_SPEED_M_S = 0.005
 WARM_UP_STEPS = 10
 WARM_UP_POSITION_STD_M = 0.10
 WARM_UP_HEAD_STD_RAD = 0.175
+# MuJoCo's instability warnings: it resets the simulation state itself when one fires, so the episode cannot go on.
+INSTABILITY_WARNINGS = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC")
 
 
 class _Sim:
@@ -48,6 +51,13 @@ class _Sim:
         self.controller.tick(self.data)
         mujoco.mj_step(self.model, self.data, nstep=physics.SUBSTEPS_PER_TICK)
 
+    def instability(self) -> str | None:
+        """The first of MuJoCo's instability warnings raised since the last reset, e.g. "mjWARN_BADQVEL"."""
+        for name in INSTABILITY_WARNINGS:
+            if self.data.warning[int(getattr(mujoco.mjtWarning, name))].number:
+                return name
+        return None
+
 
 class TavisEnv(gym.Env):
     """A TAVIS task. Observations: `pixels` (the camera mode's cameras, HxWx3 uint8), `agent_pos` (the measured
@@ -57,15 +67,19 @@ class TavisEnv(gym.Env):
     `cameras` overrides which cameras the observations carry (default: the camera mode's), e.g. to add the
     third-person `overview` camera for a video; `()` renders nothing, for recording and replay, which render what
     they need themselves.
+
+    An episode ends early, truncated and unsuccessful, if MuJoCo reports an instability (it then resets the
+    simulation state itself); `info["instability"]` names the warning and when it fired.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": physics.POLICY_HZ}
 
-    def __init__(self, task: str = "tabletop", robot: str = "gr1t2", camera_mode: str = "headcam",
+    def __init__(self, task: str = "tabletop", robot: str = "gr1t2", camera_mode: str = DEFAULT_CAMERA_MODE,
                  split: str = "id", image_size: tuple[int, int] = (480, 640), episode_length_s: float = 20.0,
                  shadows: bool = False, render_mode: str | None = "rgb_array", fps: int = physics.POLICY_HZ,
                  cameras: tuple[str, ...] | None = None):
         info = task_info(task)
+        camera_mode = resolve_camera_mode(camera_mode)
         if split not in info.splits:
             raise ValueError(f"split of task {task!r} must be one of {info.splits}, got {split!r}")
         self.camera_names = mode_cameras(camera_mode) if cameras is None else _check_cameras(cameras)
@@ -126,7 +140,14 @@ class TavisEnv(gym.Env):
         applied = sim.controller.set_command(action)
         for _ in range(self._ticks_per_step):
             sim.advance_tick()
+            if sim.instability():
+                break
         self._steps += 1
+        unstable = sim.instability()
+        if unstable:  # MuJoCo has reset the state: the episode ends, unsuccessful, with the reason
+            info = {"is_success": False, "applied_action": applied,
+                    "instability": f"{unstable} at step {self._steps} ({self._steps / self.fps:.2f} s)"}
+            return self._observe(sim), 0.0, False, True, info
         self._task.after_step(sim.model, sim.data, self._steps / self.fps)
         success = bool(self._task.is_success(sim.data))
         truncated = self._steps >= self._max_episode_steps and not success

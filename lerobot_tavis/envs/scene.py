@@ -135,7 +135,7 @@ def add_table(spec: mujoco.MjSpec) -> None:
 def add_lights(spec: mujoco.MjSpec, *, shadows: bool) -> None:
     """The dome (headlight ambient plus a weak fill from the camera) and the distant key light.
 
-    Only the key light can cast shadows, and they are opt-in: on a 2-core CPU (llvmpipe) they cut headcam 240x320
+    Only the key light can cast shadows, and they are opt-in: on a 2-core CPU (llvmpipe) they cut head_only 240x320
     from about 140 to about 30 policy steps/s (`benchmarks/env_speed.py --shadows`); a 512 px shadow map is no
     cheaper than 1024, the cost being MuJoCo's extra lit pass over the frame.
     """

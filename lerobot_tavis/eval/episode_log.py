@@ -61,7 +61,7 @@ class EpisodeLogger(gym.Wrapper):
         obs, reward, terminated, truncated, info = self.env.step(action)
         self._actions.append(info["applied_action"])
         if terminated or truncated:
-            record = self._record(bool(info["is_success"]))
+            record = self._record(bool(info["is_success"])) | {"instability": info.get("instability")}
             info = {**info, **{k: v for k, v in record.items() if k in GALT_FIELDS}}
             self._append(record)
         return obs, reward, terminated, truncated, info

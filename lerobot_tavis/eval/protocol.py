@@ -19,6 +19,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from lerobot_tavis.dataset_tools.staging import staged_directory
+from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.tasks.catalog import expand_tasks
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
@@ -43,7 +44,7 @@ class ProtocolConfig:
     suites: tuple[str, ...] = ("tavis_head",)
     splits: tuple[str, ...] = ("id", "ood_spatial", "ood_init_pose")
     n_episodes: int = 96
-    camera_mode: str = "headcam"
+    camera_mode: str = DEFAULT_CAMERA_MODE
     image_size: tuple[int, int] = (480, 640)
     episode_length_s: float = 20.0
     policy_path: str | None = None  # None: the scripted demonstrators
@@ -51,6 +52,9 @@ class ProtocolConfig:
     device: str = "cpu"
     workers: int = 1  # demonstrators: tasks of a cell in parallel processes
     seed: int = START_SEED
+
+    def __post_init__(self):
+        object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
 
 
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:

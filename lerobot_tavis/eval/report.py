@@ -57,13 +57,14 @@ class Cell:
     successes: list[bool] = field(default_factory=list)
     galt: LeadTimes = field(default_factory=LeadTimes)
     wrist_lead: LeadTimes = field(default_factory=LeadTimes)
+    unstable: int = 0  # episodes ended by a simulator instability (counted as failures)
 
     def summary(self) -> dict:
         k, n = sum(self.successes), len(self.successes)
         low, high = wilson_interval(k, n)
         return {
             "task": self.task, "suite": self.suite, "split": self.split, "n": n, "successes": k,
-            "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high,
+            "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high, "unstable": self.unstable,
             **self.galt.summary("galt"), **self.wrist_lead.summary("wrist_lead"),
         }
 
@@ -123,6 +124,7 @@ def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
             cell.successes.append(bool(record["success"]))
             cell.galt.add(record.get("galt_s"), record.get("galt_reason"))
             cell.wrist_lead.add(record.get("wrist_lead_s"), record.get("wrist_lead_reason"))
+            cell.unstable += bool(record.get("instability"))
             meta.setdefault("robots", set()).add(record["robot"])
             meta.setdefault("camera_modes", set()).add(record["camera_mode"])
     for meta in sources:
@@ -183,6 +185,10 @@ def markdown(report: dict) -> str:
     lines += _lead_table(cells, tasks, splits, "wrist_lead",
                          "Wrist lead (s): the grasping hand's wrist camera settles before the final grasp "
                          "(successful TAVIS-Hands episodes).")
+    unstable = [f"{c['task']} {c['split']}: {c['unstable']} of {c['n']}" for c in report["cells"] if c["unstable"]]
+    if unstable:
+        lines += ["", "Episodes ended by a simulator instability (counted as failures; the episode log names the "
+                  "warning): " + "; ".join(unstable) + "."]
     return "\n".join(lines) + "\n"
 
 

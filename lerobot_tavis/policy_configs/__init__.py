@@ -10,7 +10,7 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
 - Diffusion presets train offline: the ResNet-18 encoder starts from random weights with group norm. For the
   reference's ImageNet start (downloaded from download.pytorch.org) add
   `--policy.pretrained_backbone_weights=ResNet18_Weights.IMAGENET1K_V1 --policy.use_group_norm=false`.
-- Fixed-camera presets (`fixedcam`, `fixed_wrist`) train on a dataset converted with `tavis convert --zero-neck`:
+- Fixed-camera presets (`fixed_wrist`, `fixed_only`) train on a dataset converted with `tavis convert --zero-neck`:
   the neck dimensions of state and action are 0 in training, as the env reports and applies them in evaluation.
 - pi0 presets need `lerobot/pi0_base` and its tokenizer from the Hub or the local cache; `tavis train` checks that
   first and says what is missing.
@@ -28,7 +28,7 @@ import json
 from pathlib import Path
 
 from lerobot_tavis import canonical
-from lerobot_tavis.envs.modes import CAMERA_MODES, mode_cameras, neck_locked
+from lerobot_tavis.envs.modes import CAMERA_MODES, RENAMED_MODES, mode_cameras, neck_locked, resolve_camera_mode
 
 PRESET_DIR = Path(__file__).parent
 POLICIES = ("diffusion", "pi0")
@@ -52,7 +52,10 @@ def preset_names() -> list[str]:
 
 
 def preset_path(name: str) -> Path:
-    """The JSON file of preset `name` (e.g. `diffusion_headcam`)."""
+    """The JSON file of preset `name` (e.g. `diffusion_head_wrist`); old camera-mode names work, with a warning."""
+    policy, _, mode = name.partition("_")
+    if mode in RENAMED_MODES:
+        name = f"{policy}_{resolve_camera_mode(mode)}"
     if name not in presets():
         raise ValueError(f"unknown preset {name!r}; presets: {', '.join(preset_names())}")
     return PRESET_DIR / f"{name}.json"

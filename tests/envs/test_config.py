@@ -19,7 +19,7 @@ def test_every_registered_env_type_is_default_constructible():
     assert isinstance(config, TavisEnvConfig) and config.task == "tavis_head" and config.fps == 20
 
 
-@pytest.mark.parametrize("mode,cameras", [("headcam", ["head"]),
+@pytest.mark.parametrize("mode,cameras", [("head_only", ["head"]),
                                           ("fixed_wrist", ["fixed", "left_wrist", "right_wrist"])])
 def test_features_follow_the_camera_mode(mode, cameras):
     config = TavisEnvConfig(camera_mode=mode, image_size=(240, 320))

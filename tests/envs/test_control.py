@@ -6,7 +6,7 @@ import pytest
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs import physics
-from lerobot_tavis.envs.control import ArmIK, Controller
+from lerobot_tavis.envs.control import MAX_TARGET_DISTANCE_M, ArmIK, Controller
 from lerobot_tavis.envs.robots import make_robot
 from lerobot_tavis.envs.tasks.base import Task
 from lerobot_tavis.envs.tasks.catalog import TaskInfo
@@ -41,7 +41,7 @@ def _settle(controller, model, data, action, seconds):
 
 
 def test_rest_action_settles_each_hand_within_1cm_and_3deg(small_env, robot_name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixedcam")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixed_only")
     rest = canonical.rest_action()
     perturbed = rest.copy()
     perturbed[0:3] += (0.05, 0.05, -0.05)
@@ -84,7 +84,7 @@ def test_reach_grid_is_tracked_within_1cm_wherever_reachable(robot_name):
 
 
 def test_head_pitch_and_yaw_are_tracked_within_002_rad(small_env, robot_name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="headcam")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="head_only")
     env.reset(seed=0)
     limits = env.world.robot.neck_range_rad()
     for pitch_frac, yaw_frac in [(0.8, 0.0), (-0.5, 0.6), (0.3, -0.9), (0.0, 0.2)]:
@@ -96,7 +96,7 @@ def test_head_pitch_and_yaw_are_tracked_within_002_rad(small_env, robot_name):
 
 
 def test_head_and_gripper_commands_are_clipped_to_their_ranges(small_env, robot_name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="headcam")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="head_only")
     env.reset(seed=0)
     action = canonical.rest_action()
     action[canonical.HEAD] = (5.0, -5.0, 5.0)
@@ -112,7 +112,7 @@ def test_head_and_gripper_commands_are_clipped_to_their_ranges(small_env, robot_
 
 
 def test_unreachable_target_gives_the_closest_pose_never_nan(small_env, robot_name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixedcam")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixed_only")
     env.reset(seed=0)
     action = canonical.rest_action()
     action[canonical.LEFT.position] = (3.0, 2.0, 1.5)  # 3.7 m away
@@ -126,8 +126,33 @@ def test_unreachable_target_gives_the_closest_pose_never_nan(small_env, robot_na
         assert after < before - 0.1  # the hand stretched toward the target
 
 
+@pytest.mark.parametrize("distance_m", [1e4, 1e200])
+def test_a_target_at_any_finite_distance_gives_the_closest_pose_in_its_direction(small_env, distance_m):
+    direction = np.array([3.0, 2.0, 1.5]) / np.linalg.norm([3.0, 2.0, 1.5])
+    reached = {}
+    for distance in (MAX_TARGET_DISTANCE_M, distance_m):
+        env = small_env(task="tabletop", robot="gr1t2", camera_mode="fixed_only")
+        env.reset(seed=0)
+        action = canonical.rest_action()
+        action[canonical.LEFT.position] = direction * distance
+        reached[distance] = run_steps(env, action, 40)["agent_pos"][canonical.LEFT.position]
+    rest = canonical.rest_action()[canonical.LEFT.position]
+    assert np.linalg.norm(reached[distance_m] - rest) > 0.1  # the hand stretched toward the far target
+    np.testing.assert_allclose(reached[distance_m], reached[MAX_TARGET_DISTANCE_M], atol=1e-6)
+
+
+def test_a_huge_quaternion_is_normalised_not_turned_into_nan(small_env):
+    env = small_env(task="tabletop", robot="gr1t2", camera_mode="fixed_only")
+    env.reset(seed=0)
+    action = canonical.rest_action()
+    action[canonical.LEFT.quaternion] *= 1e200
+    applied = env.step(action)[4]["applied_action"]
+    np.testing.assert_allclose(applied[canonical.LEFT.quaternion], canonical.rest_action()[canonical.LEFT.quaternion])
+    assert np.all(np.isfinite(applied))
+
+
 def test_bad_actions_raise_naming_the_problem(small_env):
-    env = small_env(task="tabletop", robot="gr1t2", camera_mode="fixedcam")
+    env = small_env(task="tabletop", robot="gr1t2", camera_mode="fixed_only")
     env.reset(seed=0)
     with pytest.raises(ValueError, match=r"shape \(19,\)"):
         env.step(np.zeros(18))

@@ -29,7 +29,7 @@ def _rollout(env, seed):
     return frames
 
 
-@pytest.mark.parametrize("camera_mode", ["head_wrist", "fixedcam"])
+@pytest.mark.parametrize("camera_mode", ["head_wrist", "fixed_only"])
 def test_same_seed_same_episode_same_pixels(small_env, robot_name, camera_mode):
     first = _rollout(small_env(robot=robot_name, camera_mode=camera_mode), seed=7)
     second = _rollout(small_env(robot=robot_name, camera_mode=camera_mode), seed=7)
@@ -41,7 +41,7 @@ def test_same_seed_same_episode_same_pixels(small_env, robot_name, camera_mode):
 
 
 def test_reset_with_the_same_seed_reproduces_and_another_seed_differs(small_env):
-    env = small_env(robot="gr1t2", camera_mode="fixedcam")
+    env = small_env(robot="gr1t2", camera_mode="fixed_only")
     first = env.reset(seed=3)[0]["pixels"]["fixed"]
     run_steps(env, canonical.rest_action(), 5)
     again = env.reset(seed=3)[0]["pixels"]["fixed"]
@@ -51,7 +51,7 @@ def test_reset_with_the_same_seed_reproduces_and_another_seed_differs(small_env)
 
 
 @pytest.mark.parametrize("camera_mode,cameras", [
-    ("headcam", {"head"}), ("fixedcam", {"fixed"}),
+    ("head_only", {"head"}), ("fixed_only", {"fixed"}),
     ("head_wrist", {"head", "left_wrist", "right_wrist"}), ("fixed_wrist", {"fixed", "left_wrist", "right_wrist"})])
 def test_observation_holds_only_the_camera_modes_cameras(small_env, camera_mode, cameras):
     env = small_env(robot="gr1t2", camera_mode=camera_mode, image_size=(24, 32))
@@ -66,7 +66,7 @@ def test_observation_holds_only_the_camera_modes_cameras(small_env, camera_mode,
 
 
 def test_what_lerobot_reads(small_env):
-    env = small_env(robot="reachy2", camera_mode="headcam", episode_length_s=0.5)
+    env = small_env(robot="reachy2", camera_mode="head_only", episode_length_s=0.5)
     assert env.metadata["render_fps"] == 20
     assert env._max_episode_steps == 10
     assert env.task == "tabletop" and isinstance(env.task_description, str) and env.task_description
@@ -88,7 +88,7 @@ def test_render_returns_the_last_frames_without_rendering_again(small_env, monke
 
 
 def test_simulator_is_built_lazily_and_released_by_close():
-    env = TavisEnv(robot="gr1t2", camera_mode="fixedcam", image_size=(24, 32))
+    env = TavisEnv(robot="gr1t2", camera_mode="fixed_only", image_size=(24, 32))
     assert env._sim is None
     clone = pickle.loads(pickle.dumps(env))  # what a forkserver worker receives
     clone.reset(seed=0)
@@ -100,7 +100,7 @@ def test_simulator_is_built_lazily_and_released_by_close():
         env.render()
 
 
-@pytest.mark.parametrize("camera_mode", ["fixedcam", "fixed_wrist"])
+@pytest.mark.parametrize("camera_mode", ["fixed_only", "fixed_wrist"])
 def test_fixed_camera_modes_hold_the_neck_at_zero(small_env, camera_mode):
     env = small_env(robot="gr1t2", camera_mode=camera_mode)
     env.reset(seed=0)
@@ -128,7 +128,7 @@ def test_bad_arguments_raise_clear_errors(kwargs, message):
 
 
 def test_gymnasium_env_checker(small_env):
-    check_env(small_env(robot="gr1t2", camera_mode="fixedcam", image_size=(24, 32)), skip_render_check=True)
+    check_env(small_env(robot="gr1t2", camera_mode="fixed_only", image_size=(24, 32)), skip_render_check=True)
 
 
 def test_a_60hz_env_steps_one_control_tick_and_counts_time_in_seconds(small_env):
@@ -148,7 +148,7 @@ def test_a_60hz_env_steps_one_control_tick_and_counts_time_in_seconds(small_env)
 
 
 def test_cameras_override_the_mode_and_none_renders_nothing(small_env):
-    env = small_env(camera_mode="headcam", cameras=("fixed", "left_wrist"))
+    env = small_env(camera_mode="head_only", cameras=("fixed", "left_wrist"))
     obs, _ = env.reset(seed=0)
     assert list(obs["pixels"]) == ["fixed", "left_wrist"]
     blind = small_env(cameras=())
@@ -159,7 +159,7 @@ def test_cameras_override_the_mode_and_none_renders_nothing(small_env):
 
 
 def test_the_overview_camera_is_for_people_only(small_env):
-    for camera_mode in ("headcam", "fixedcam", "head_wrist", "fixed_wrist"):
+    for camera_mode in ("head_only", "fixed_only", "head_wrist", "fixed_wrist"):
         assert "overview" not in small_env(camera_mode=camera_mode).camera_names
     env = small_env(cameras=("overview", "head"))
     obs, _ = env.reset(seed=0)
@@ -167,3 +167,16 @@ def test_the_overview_camera_is_for_people_only(small_env):
     assert overview.shape == head.shape and overview.std() > 10 and not np.array_equal(overview, head)
     with pytest.raises(ValueError, match="overview"):
         small_env(cameras=("topdown",))
+
+
+def test_an_unstable_simulation_ends_the_episode_with_the_reason(small_env):
+    env = small_env(task="conditional_pick", robot="gr1t2", camera_mode="fixed_only", image_size=(16, 16))
+    env.reset(seed=0)
+    _, _, _, truncated, info = env.step(canonical.rest_action())
+    assert not truncated and "instability" not in info
+    env.unwrapped._sim.data.qvel[:] = 1e12  # a body at 1e12 m/s: MuJoCo warns and resets its state
+    _, reward, terminated, truncated, info = env.step(canonical.rest_action())
+    assert truncated and not terminated and reward == 0.0 and not info["is_success"]
+    assert info["instability"] == "mjWARN_BADQVEL at step 2 (0.10 s)"
+    env.reset(seed=0)  # a new episode starts clean
+    assert "instability" not in env.step(canonical.rest_action())[4]

@@ -192,13 +192,13 @@ def test_blocked_head_camera_is_black_and_the_head_still_moves(small_env):
     for _ in range(15):
         obs, *_ = env.step(action)
     assert not obs["pixels"]["head"].any() and obs["agent_pos"][canonical.HEAD_YAW] == pytest.approx(0.5, abs=0.02)
-    open_env = small_env(task="clutter_pick_cube", camera_mode="headcam")
+    open_env = small_env(task="clutter_pick_cube", camera_mode="head_only")
     assert open_env.reset(seed=0)[0]["pixels"]["head"].any()
 
 
 @pytest.mark.parametrize("task_name", TAVIS_TASKS)
 def test_seed_reproduces_layout_and_prompt_and_objects_are_still(small_env, task_name):
-    first, second = (small_env(task=task_name, camera_mode="fixedcam", image_size=(16, 16)) for _ in range(2))
+    first, second = (small_env(task=task_name, camera_mode="fixed_only", image_size=(16, 16)) for _ in range(2))
     first.reset(seed=11)
     second.reset(seed=11)
     np.testing.assert_array_equal(first.data.qpos, second.data.qpos)
@@ -209,7 +209,7 @@ def test_seed_reproduces_layout_and_prompt_and_objects_are_still(small_env, task
 
 @pytest.mark.parametrize("task_name", ["clutter_pick_lift", "multi_shelf_scan"])
 def test_prompts_vary_with_the_seed(small_env, task_name):
-    env = small_env(task=task_name, camera_mode="fixedcam", image_size=(16, 16))
+    env = small_env(task=task_name, camera_mode="fixed_only", image_size=(16, 16))
     prompts = {env.reset(seed=seed)[0] and env.task_description for seed in range(30)}
     assert len(prompts) >= 8 and prompts <= set(TASKS[task_name].prompts)
 
@@ -225,8 +225,8 @@ def test_warm_up_noise_has_the_reference_spread():
 
 
 def test_ood_init_pose_starts_from_the_id_scene_with_a_perturbed_robot(small_env):
-    nominal = small_env(task="clutter_pick_lift", split="id", camera_mode="fixedcam")
-    perturbed = small_env(task="clutter_pick_lift", split="ood_init_pose", camera_mode="fixedcam")
+    nominal = small_env(task="clutter_pick_lift", split="id", camera_mode="fixed_only")
+    perturbed = small_env(task="clutter_pick_lift", split="ood_init_pose", camera_mode="fixed_only")
     id_obs, _ = nominal.reset(seed=5)
     ood_obs, _ = perturbed.reset(seed=5)
     for name in OBJECT_NAMES:
@@ -257,10 +257,10 @@ def test_ood_init_pose_warm_up_counts_toward_the_episode_and_the_task_clock(smal
 
     warm_up_steps = fps // 2  # 10 policy steps at 20 Hz: 0.5 s
     lengths = {split: _steps_until(small_env(task="clutter_pick_lift", split=split, episode_length_s=2.0, fps=fps,
-                                             camera_mode="fixedcam", cameras=()), 3, truncated)
+                                             camera_mode="fixed_only", cameras=()), 3, truncated)
                for split in ("id", "ood_init_pose")}
     assert lengths == {"id": 2 * fps, "ood_init_pose": 2 * fps - warm_up_steps}
-    greens = {split: _steps_until(small_env(task="wait_then_act", split=split, fps=fps, camera_mode="fixedcam",
+    greens = {split: _steps_until(small_env(task="wait_then_act", split=split, fps=fps, camera_mode="fixed_only",
                                             cameras=()), 4, green)
               for split in ("id", "ood_init_pose")}
     assert greens["id"] - greens["ood_init_pose"] == warm_up_steps

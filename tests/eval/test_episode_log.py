@@ -19,7 +19,7 @@ class ScriptedEnv(gym.Env):
     observation_space = gym.spaces.Box(-1, 1, (1,))
     action_space = gym.spaces.Box(-np.inf, np.inf, (19,))
 
-    def __init__(self, actions, success=True, camera_mode="headcam"):
+    def __init__(self, actions, success=True, camera_mode="head_only"):
         self.actions, self.success = actions, success
         self.robot_name, self.task, self.split, self.camera_mode = "gr1t2", "clutter_pick_lift", "id", camera_mode
         self.task_description = "Lift the red soup can off the table."
@@ -62,7 +62,7 @@ def test_no_galt_for_failures_or_fixed_camera_modes(tmp_path):
     actions = episode(20, 3.0, 1.0, hand=(1.4, 2.0), grasp_s=2.0)
     log = tmp_path / "episodes.jsonl"
     for env in (EpisodeLogger(ScriptedEnv(actions, success=False), log, "tavis_head", 0),
-                EpisodeLogger(ScriptedEnv(actions, camera_mode="fixedcam"), log, "tavis_head", 0)):
+                EpisodeLogger(ScriptedEnv(actions, camera_mode="fixed_only"), log, "tavis_head", 0)):
         _run(env, 7, len(actions))
     records = [json.loads(line) for line in log.read_text().splitlines()]
     assert len(records) == 2 and [r["success"] for r in records] == [False, True]
@@ -77,3 +77,18 @@ def test_hands_episodes_log_the_wrist_lead_of_the_final_grasp(tmp_path):
     assert record["wrist_lead_reason"] == "ok" and record["wrist_lead_arm"] == "right"
     assert abs(record["wrist_lead_s"] - 1.6) < 0.1
     assert record["galt_s"] is None  # fixed camera: no GALT
+
+
+def test_an_episode_ended_by_an_instability_logs_the_warning(tmp_path):
+    from lerobot_tavis.envs.env import TavisEnv
+
+    log = tmp_path / "episodes.jsonl"
+    env = EpisodeLogger(TavisEnv("conditional_pick", camera_mode="fixed_only", image_size=(16, 16), cameras=()),
+                        log, "tavis_head", 0)
+    env.reset(seed=3)
+    env.step(canonical.rest_action())
+    env.unwrapped._sim.data.qvel[:] = 1e12
+    env.step(canonical.rest_action())
+    (record,) = [json.loads(line) for line in log.read_text().splitlines()]
+    assert not record["success"] and record["instability"].startswith("mjWARN_BADQVEL at step 2")
+    env.close()

@@ -9,7 +9,7 @@ from lerobot_tavis.eval.report import build_report, join, markdown, write_report
 
 def _record(task, task_id, seed, success, split="id", galt=None):
     return {"robot": "gr1t2", "suite": "tavis_head", "task": task, "task_id": task_id, "split": split,
-            "camera_mode": "headcam", "seed": seed, "success": success, "length_steps": 100,
+            "camera_mode": "head_only", "seed": seed, "success": success, "length_steps": 100,
             "galt_s": galt, "galt_reason": ("ok" if galt is not None else None) if success else None}
 
 
@@ -83,3 +83,15 @@ def test_missing_or_corrupt_logs_give_clear_errors(tmp_path):
         join(tmp_path / "a")
     with pytest.raises(FileNotFoundError, match="no eval_info.json"):
         build_report(tmp_path / "a" / "nothing")
+
+
+def test_the_report_counts_episodes_ended_by_an_instability(tmp_path):
+    _eval_dir(tmp_path / "id", "id", {"conditional_pick": [True, False, False]}, extra=0)
+    log = tmp_path / "id" / "episodes.jsonl"
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    records[0]["instability"] = "mjWARN_BADQACC at step 7 (0.35 s)"  # seed 1002, a failure
+    log.write_text("".join(json.dumps(r) + "\n" for r in records))
+    report = build_report(tmp_path)
+    assert report["cells"][0]["unstable"] == 1
+    assert "simulator instability (counted as failures" in markdown(report) and "conditional_pick id: 1 of 3" in \
+        markdown(report)
