@@ -1,19 +1,16 @@
 """Process pools for the dataset tools: `workers` spawned processes, or the calling process when workers == 1.
 
-A worker never outlives the process that started it: on Linux the kernel kills it when its parent dies
-(`PR_SET_PDEATHSIG`), kill -9 included, so no orphan keeps recording or holds staging files.
+A worker never outlives the process that started it (`lerobot_tavis.process`), so no orphan keeps recording or
+holds staging files.
 """
 
 from __future__ import annotations
 
-import ctypes
 import multiprocessing
 import os
-import signal
-import sys
 from concurrent.futures import Future, ProcessPoolExecutor
 
-_PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
+from lerobot_tavis.process import die_with_parent
 
 
 class InlineExecutor:
@@ -43,12 +40,3 @@ def executor(workers: int) -> InlineExecutor | ProcessPoolExecutor:
     return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=die_with_parent,
                                initargs=(os.getpid(),))
 
-
-def die_with_parent(parent_pid: int) -> None:
-    """Ask the kernel to kill this process when its parent dies; exit now if the parent is already gone."""
-    if sys.platform.startswith("linux"):
-        libc = ctypes.CDLL(None, use_errno=True)
-        if libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL) != 0:
-            raise OSError(ctypes.get_errno(), "prctl(PR_SET_PDEATHSIG) failed")
-    if os.getppid() != parent_pid:  # the parent died before the request took effect
-        os._exit(1)

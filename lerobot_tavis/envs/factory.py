@@ -12,8 +12,12 @@ import gymnasium as gym
 def make_tavis_env(task: str, robot: str, camera_mode: str, split: str, image_size: tuple[int, int],
                    episode_length_s: float, episode_log: str | None = None, suite: str = "",
                    task_id: int = 0) -> gym.Env:
-    """One sub-env (picklable through functools.partial for forkserver workers)."""
+    """One sub-env (picklable through functools.partial for forkserver workers). In a worker process it also
+    binds the worker's life to its parent's, so an env worker never outlives a killed lerobot-eval or tavis eval."""
     from lerobot_tavis.envs.env import TavisEnv  # imports MuJoCo: only in the process that simulates
+    from lerobot_tavis.process import bind_worker_to_parent
+
+    bind_worker_to_parent()
 
     env = TavisEnv(task, robot, camera_mode=camera_mode, split=split, image_size=tuple(image_size),
                    episode_length_s=episode_length_s)

@@ -1,4 +1,4 @@
-"""Worker processes of `tavis record` and `tavis convert` die with their parent, kill -9 included."""
+"""Worker processes of `tavis record` and `tavis eval` die with their parent, kill -9 included."""
 
 import os
 import signal
@@ -35,9 +35,17 @@ def _wait_for(condition, timeout_s: float) -> bool:
     return False
 
 
-def test_record_workers_exit_when_the_parent_is_killed(tmp_path):
-    command = [sys.executable, "-m", "lerobot_tavis.cli", "record", "--robot", "gr1t2", "--tasks", "conditional_pick",
-               "--episodes-per-task", "50", "--workers", "2", "--out", str(tmp_path / "raw")]
+COMMANDS = {
+    "record": ["record", "--robot", "gr1t2", "--tasks", "conditional_pick", "--episodes-per-task", "50",
+               "--workers", "2", "--out"],
+    "eval": ["eval", "--expert", "--suite", "tavis_hands", "--splits", "id", "--episodes", "50",
+             "--image-size", "24x32", "--workers", "2", "--out"],
+}
+
+
+@pytest.mark.parametrize("name", COMMANDS)
+def test_workers_exit_when_the_parent_is_killed(tmp_path, name):
+    command = [sys.executable, "-m", "lerobot_tavis.cli", *COMMANDS[name], str(tmp_path / "out")]
     parent = subprocess.Popen(command, env={**os.environ, "MUJOCO_GL": "egl"}, stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL)
     try:
