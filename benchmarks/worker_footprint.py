@@ -4,7 +4,7 @@
                                                         [--no-render]
 
 Each measurement is a fresh Python process, as a worker of `tavis record`, `tavis eval --expert` or LeRobot's async
-vector envs is: it times `import lerobot_tavis.envs.env`, builds a TavisEnv at 96x128 (the default camera mode),
+vector envs is: it times `import lerobot_tavis.envs.env`, builds a TavisEnv at 96x128 (head and wrist cameras),
 plays one demonstrator episode and reads its peak resident memory (`ru_maxrss`). Prints one line per process, the
 medians, and whether torch or LeRobot was imported. `--no-render` builds the env with no cameras, as the workers of
 `tavis record` and `benchmarks/expert_success.py` do (no GL context).
@@ -28,7 +28,7 @@ def measure(task: str, robot: str, render: bool) -> dict:
     import_s = time.perf_counter() - start
     from lerobot_tavis.experts.registry import run_episode
 
-    env = TavisEnv(task, robot, image_size=(96, 128), cameras=None if render else ())
+    env = TavisEnv(task, robot, camera_mode="head_wrist", image_size=(96, 128), cameras=None if render else ())
     result = run_episode(env, seed=0)
     env.close()
     return {"import_s": import_s, "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
