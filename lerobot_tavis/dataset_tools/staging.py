@@ -1,4 +1,9 @@
-"""Write a directory completely or not at all: build it beside its destination, then move it into place."""
+"""Write a directory completely or not at all: build it beside its destination, then move it into place.
+
+The staging copy is named `.<name>.partial-<pid>-<id>`, so a later run can tell the leftovers of a killed run
+(whose process is gone) from those of a run still going, and removes them. Readers of finished outputs skip
+dot-named directories.
+"""
 
 from __future__ import annotations
 
@@ -16,14 +21,15 @@ def staged_directory(destination: str | Path, *, overwrite: bool = False) -> Ite
     `destination`, otherwise it is removed. An existing destination is an error unless `overwrite`, and is then
     replaced only once the new one is complete."""
     destination = Path(destination).absolute()
+    clear_leftovers(destination)
     if destination.exists() and not overwrite:
         raise FileExistsError(f"{destination} already exists (pass --overwrite to replace it)")
     destination.parent.mkdir(parents=True, exist_ok=True)
-    staging = destination.with_name(f".{destination.name}.partial-{uuid.uuid4().hex[:8]}")
+    staging = destination.with_name(f".{destination.name}.partial-{os.getpid()}-{uuid.uuid4().hex[:8]}")
     try:
         yield staging
         if destination.exists():
-            retired = destination.with_name(f".{destination.name}.old-{uuid.uuid4().hex[:8]}")
+            retired = destination.with_name(f".{destination.name}.old-{os.getpid()}-{uuid.uuid4().hex[:8]}")
             os.replace(destination, retired)
             os.replace(staging, destination)
             shutil.rmtree(retired)
@@ -31,3 +37,27 @@ def staged_directory(destination: str | Path, *, overwrite: bool = False) -> Ite
             os.replace(staging, destination)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+def clear_leftovers(destination: Path) -> None:
+    """Remove the staging copies that killed runs left beside `destination`; a run killed while swapping in its
+    result leaves the previous destination retired: it is put back if nothing replaced it."""
+    for leftover in sorted(destination.parent.glob(f".{destination.name}.*-*-*")):
+        kind, _, owner = leftover.name[len(destination.name) + 2:].partition("-")
+        pid = owner.split("-")[0]
+        if kind not in ("partial", "old") or not pid.isdigit() or _alive(int(pid)):
+            continue
+        if kind == "old" and not destination.exists():
+            os.replace(leftover, destination)
+        else:
+            shutil.rmtree(leftover, ignore_errors=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True

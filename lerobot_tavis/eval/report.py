@@ -112,7 +112,9 @@ def join(eval_dir: Path) -> tuple[list[dict], dict]:
 def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
     cells: dict[tuple[str, str], Cell] = {}
     sources = []
-    info_files = sorted(root.rglob(EVAL_INFO_NAME))
+    # Dot-named folders are staging copies (finished or left by a killed run), never results.
+    info_files = sorted(path for path in root.rglob(EVAL_INFO_NAME)
+                        if not any(part.startswith(".") for part in path.relative_to(root).parts))
     if not info_files:
         raise FileNotFoundError(f"no {EVAL_INFO_NAME} under {root}")
     for info_path in info_files:

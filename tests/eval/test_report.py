@@ -83,15 +83,3 @@ def test_missing_or_corrupt_logs_give_clear_errors(tmp_path):
         join(tmp_path / "a")
     with pytest.raises(FileNotFoundError, match="no eval_info.json"):
         build_report(tmp_path / "a" / "nothing")
-
-
-def test_the_report_counts_episodes_ended_by_an_instability(tmp_path):
-    _eval_dir(tmp_path / "id", "id", {"conditional_pick": [True, False, False]}, extra=0)
-    log = tmp_path / "id" / "episodes.jsonl"
-    records = [json.loads(line) for line in log.read_text().splitlines()]
-    records[0]["instability"] = "mjWARN_BADQACC at step 7 (0.35 s)"  # seed 1002, a failure
-    log.write_text("".join(json.dumps(r) + "\n" for r in records))
-    report = build_report(tmp_path)
-    assert report["cells"][0]["unstable"] == 1
-    assert "simulator instability (counted as failures" in markdown(report) and "conditional_pick id: 1 of 3" in \
-        markdown(report)
