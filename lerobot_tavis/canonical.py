@@ -70,10 +70,23 @@ def rest_action() -> np.ndarray:
 def validate_action(action) -> np.ndarray:
     """Return `action` as a float64 (19,) array, or raise ValueError naming what is wrong.
 
-    Checks the shape, that every value is finite, and that both quaternions have a usable norm. Range clipping
-    (head, grippers) is robot-specific and done by the controller.
+    Checks that it is real numbers (a complex part is never dropped silently), the shape, that every value is
+    finite, and that both quaternions have a usable norm. Range clipping (head, grippers) is robot-specific and done
+    by the controller.
     """
-    array = np.asarray(action, dtype=np.float64)
+    try:
+        raw = np.asarray(action)
+    except ValueError:  # ragged nesting
+        raw = np.asarray(None)
+    if raw.dtype.kind == "c" or (raw.dtype.kind == "O" and any(np.iscomplexobj(v) for v in raw.flat)):
+        raise ValueError(f"action must be real numbers, got complex values ({type(action).__name__} of {raw.dtype})")
+    try:
+        numeric = raw.dtype.kind in "biuf" or (raw.dtype.kind == "O" and raw.ndim > 0)
+        array = raw.astype(np.float64) if numeric else None
+    except (TypeError, ValueError):  # objects that are not numbers
+        array = None
+    if array is None:
+        raise ValueError(f"action must be an array of {ACTION_DIM} numbers, got {type(action).__name__}")
     if array.shape != (ACTION_DIM,):
         raise ValueError(f"action must have shape ({ACTION_DIM},), got {array.shape}")
     bad = np.flatnonzero(~np.isfinite(array))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 import signal
 import sys
 import threading
@@ -11,7 +12,7 @@ from pathlib import Path
 from lerobot_tavis.dataset_tools.features import STORAGES
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, RENAMED_MODES
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
-from lerobot_tavis.errors import TavisError
+from lerobot_tavis.errors import FieldError, TavisError
 
 
 def _demo(args: argparse.Namespace) -> None:
@@ -140,11 +141,10 @@ def _train(args: argparse.Namespace) -> None:
 
 
 def _image_size(text: str) -> tuple[int, int]:
-    try:
-        height, width = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"image size must look like 480x640 (height x width), got {text!r}")
-    return height, width
+    match = re.fullmatch(r"\s*([0-9]+)\s*[xX]\s*([0-9]+)\s*", text)
+    if not match or not all(int(side) > 0 for side in match.groups()):
+        raise ValueError(f"--image-size must be HxW in pixels, e.g. 480x640 (height x width), got {text!r}")
+    return int(match[1]), int(match[2])
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -183,7 +183,7 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--workers", type=int, default=1, help="parallel processes (demonstrator runs)")
     evaluate.add_argument("--seed", type=int, default=1000, help="first episode seed (lerobot-eval's default)")
     evaluate.add_argument("--out", required=True, help="output directory; finished cells are skipped on re-runs")
-    evaluate.set_defaults(run=_eval)
+    evaluate.set_defaults(run=_eval, options={"n_episodes": "--episodes"})
 
     rec = commands.add_parser("record", help="record scripted demonstrations at 60 Hz (replayable raw episodes)")
     rec.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
@@ -233,7 +233,7 @@ def build_parser() -> argparse.ArgumentParser:
     pull.add_argument("repo_id", help="<user>/<name> on the Hub")
     pull.add_argument("--root", help="where to put it (default: LeRobot's cache)")
     pull.add_argument("--revision", help="branch, tag or commit")
-    pull.set_defaults(run=_pull)
+    pull.set_defaults(run=_pull, options={"repo_id": "repo_id"})
 
     presets = commands.add_parser("presets", help="list the training presets, or print the path of one")
     presets.add_argument("name", nargs="?", help="a preset name, e.g. diffusion_head_wrist")
@@ -262,7 +262,15 @@ def main(argv: list[str] | None = None) -> None:
     try:
         args.run(args)
     except (ValueError, FileExistsError, FileNotFoundError, TavisError) as error:
-        sys.exit(f"tavis {args.command}: error: {error}")
+        sys.exit(f"tavis {args.command}: error: {_message(error, args)}")
+
+
+def _message(error: Exception, args: argparse.Namespace) -> str:
+    """The error in one line; a config's error about one of its fields names the option that set it instead."""
+    if isinstance(error, FieldError):
+        option = getattr(args, "options", {}).get(error.field, "--" + error.field.replace("_", "-"))
+        return f"{option} {error.problem}"
+    return str(error)
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from lerobot_tavis import checks
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_NAMES
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
@@ -41,6 +42,7 @@ def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) 
 
 def run_demo(out_dir: str | Path, robots=("gr1t2", "reachy2"), tasks=TASKS, image_size=(240, 320),
              seed: int = 0) -> list[Path]:
+    checks.integer("seed", seed, 0)
     out_dir = Path(out_dir)
     written = []
     for robot in robots:

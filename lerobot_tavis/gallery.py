@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
-from lerobot_tavis import canonical
+from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_info
@@ -127,6 +127,7 @@ def overview_figure(stills: dict[str, Stills], portraits: dict[str, np.ndarray])
 def write_gallery(out_dir: str | Path, *, robots=ROBOTS, tasks=BENCHMARK_TASKS, image_size=(240, 320),
                   seed: int = 0, figure_robot: str = "gr1t2") -> list[Path]:
     """Render every task sheet and, when all eight tasks of `figure_robot` are included, the overview figure."""
+    checks.integer("seed", seed, 0)
     out_dir = Path(out_dir)
     written, by_robot = [], {}
     jobs = [(robot, task) for robot in robots for task in tasks]

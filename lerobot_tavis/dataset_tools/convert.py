@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from lerobot_tavis import canonical
+from lerobot_tavis import canonical, checks
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
 from lerobot_tavis.dataset_tools.staging import staged_directory
@@ -54,6 +54,11 @@ class ConvertConfig:
     zero_neck: bool = False  # neck dims of state and action set to 0: fixed-camera training (reference §9)
     storage: str = "av1"  # how frames are stored: features.STORAGES
     workers: int = 1  # replaying processes
+
+    def __post_init__(self):
+        checks.repo_id(self.repo_id)
+        checks.image_size(self.image_size)
+        checks.integer("workers", self.workers, 1)
 
 
 def convert(cfg: ConvertConfig, progress: bool = True) -> Path:

@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_tavis import canonical
+from lerobot_tavis import canonical, checks
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SPLITS
@@ -90,6 +90,7 @@ def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, 
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
     from tqdm import tqdm
 
+    checks.repo_id(repo_id)
     source_root = Path(source_root)
     if not (source_root / "meta" / "info.json").is_file():
         raise FileNotFoundError(f"source_root {source_root} holds no LeRobot dataset (meta/info.json missing)")

@@ -13,6 +13,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from urllib.parse import quote
 
+from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.features import JOINT_POS_KEY, SPLIT_KEY, STATE_KEY, TASK_NAME_KEY
 from lerobot_tavis.envs.tasks.catalog import TASKS, task_sort_key
 from lerobot_tavis.errors import TavisError
@@ -105,8 +106,9 @@ def push_dataset(root: str | Path, repo_id: str, *, private: bool = False, branc
                  provenance: str = PROVENANCE) -> str:
     """Upload the local TAVIS dataset at `root` to the Hub as `repo_id` with our card; returns the dataset's URL.
 
-    Checks that `root` is a dataset and that a Hub token exists before uploading anything.
+    Checks `repo_id`, that `root` is a dataset and that a Hub token exists before uploading anything.
     """
+    checks.repo_id(repo_id)
     root = _check_dataset_root(root)
     from huggingface_hub import HfApi, constants, get_token
     from huggingface_hub.errors import RevisionNotFoundError
@@ -133,6 +135,7 @@ def pull_dataset(repo_id: str, root: str | Path | None = None, revision: str | N
 
     A complete copy already in `root` is loaded without contacting the Hub.
     """
+    checks.repo_id(repo_id)
     from lerobot.datasets import LeRobotDataset
 
     with _hub_errors(repo_id):

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
 from lerobot_tavis.dataset_tools.workers import executor
 
@@ -38,10 +39,9 @@ class RecordConfig:
     max_attempts_factor: float = 3.0
 
     def __post_init__(self):
-        if self.episodes_per_task < 1:
-            raise ValueError(f"episodes_per_task must be >= 1, got {self.episodes_per_task}")
-        if self.workers < 1:
-            raise ValueError(f"workers must be >= 1, got {self.workers}")
+        checks.integer("episodes_per_task", self.episodes_per_task, 1)
+        checks.integer("workers", self.workers, 1)
+        checks.integer("seed_start", self.seed_start, 0)
         if not self.tasks:
             raise ValueError("tasks must name at least one task")
 

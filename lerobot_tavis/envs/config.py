@@ -19,7 +19,7 @@ from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.envs.configs import EnvConfig
 from lerobot.envs.utils import _LazyAsyncVectorEnv, freeze_after_episode_end
 
-from lerobot_tavis import canonical
+from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.factory import make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.tasks.catalog import SPLITS, expand_tasks
@@ -51,7 +51,8 @@ class TavisEnvConfig(EnvConfig):
             raise ValueError(f"split must be one of {SPLITS}, got {self.split!r}")
         if self.fps != 20:
             raise ValueError(f"fps is fixed by the benchmark at 20, got {self.fps}")
-        height, width = self.image_size
+        height, width = checks.image_size(self.image_size)
+        checks.episode_steps(self.episode_length_s, self.fps)
         self.features = {"action": PolicyFeature(FeatureType.ACTION, (canonical.ACTION_DIM,)),
                          "agent_pos": PolicyFeature(FeatureType.STATE, (canonical.ACTION_DIM,))}
         self.features_map = {"action": "action", "agent_pos": "observation.state"}

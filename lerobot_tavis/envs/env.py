@@ -14,7 +14,7 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
-from lerobot_tavis import canonical
+from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.control import Controller
 from lerobot_tavis.envs.modes import (CAMERA_NAMES, DEFAULT_CAMERA_MODE, VIEW_CAMERAS, mode_cameras, neck_locked,
@@ -84,13 +84,12 @@ class TavisEnv(gym.Env):
             raise ValueError(f"split of task {task!r} must be one of {info.splits}, got {split!r}")
         self.camera_names = mode_cameras(camera_mode) if cameras is None else _check_cameras(cameras)
         make_robot(robot)  # validates the name; the model itself is built on the first reset
-        height, width = _check_image_size(image_size)
-        if not episode_length_s > 0:
-            raise ValueError(f"episode_length_s must be > 0, got {episode_length_s}")
+        height, width = checks.image_size(image_size)
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be 'rgb_array' or None, got {render_mode!r}")
         if not (isinstance(fps, int) and fps > 0 and physics.CONTROL_HZ % fps == 0):
             raise ValueError(f"fps must divide the {physics.CONTROL_HZ} Hz control rate (20, 30, 60, ...), got {fps!r}")
+        max_episode_steps = checks.episode_steps(episode_length_s, fps)
 
         self.task = task
         self.task_description = info.prompts[0]
@@ -103,7 +102,7 @@ class TavisEnv(gym.Env):
         self.fps = fps
         self.metadata = {**self.metadata, "render_fps": fps}
         self._ticks_per_step = physics.CONTROL_HZ // fps
-        self._max_episode_steps = int(round(episode_length_s * fps))
+        self._max_episode_steps = max_episode_steps
         self._task = make_task(task, "id" if split == "ood_init_pose" else split)
         self._robot = make_robot(robot)
         self._sim: _Sim | None = None
@@ -252,16 +251,6 @@ def _check_cameras(cameras) -> tuple[str, ...]:
     if not set(cameras) <= set(known) or len(set(cameras)) != len(cameras):
         raise ValueError(f"cameras must be distinct names among {known}, got {cameras!r}")
     return cameras
-
-
-def _check_image_size(image_size) -> tuple[int, int]:
-    try:
-        height, width = (int(v) for v in image_size)
-    except (TypeError, ValueError):
-        raise ValueError(f"image_size must be (height, width), got {image_size!r}") from None
-    if not (16 <= height <= 4096 and 16 <= width <= 4096):
-        raise ValueError(f"image_size must be within 16..4096 pixels per side, got {image_size!r}")
-    return height, width
 
 
 def _action_space(neck_range: np.ndarray) -> gym.spaces.Box:

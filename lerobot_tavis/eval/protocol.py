@@ -18,8 +18,10 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, resolve_camera_mode
+from lerobot_tavis.envs.physics import POLICY_HZ
 from lerobot_tavis.envs.tasks.catalog import expand_tasks
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
@@ -55,6 +57,12 @@ class ProtocolConfig:
 
     def __post_init__(self):
         object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
+        checks.integer("n_episodes", self.n_episodes, 1)
+        checks.integer("batch_size", self.batch_size, 1)
+        checks.integer("workers", self.workers, 1)
+        checks.integer("seed", self.seed, 0)
+        checks.image_size(self.image_size)
+        checks.episode_steps(self.episode_length_s, POLICY_HZ)
 
 
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:

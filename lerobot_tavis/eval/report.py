@@ -81,9 +81,27 @@ def read_episode_log(path: Path) -> list[dict]:
     return records
 
 
+def read_eval_info(path: Path) -> dict:
+    """A lerobot-eval `eval_info.json`; ValueError naming the file when it is not JSON or lacks what is read."""
+    try:
+        info = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        reason = f"{error.msg} at line {error.lineno}" if isinstance(error, json.JSONDecodeError) else "not text"
+        raise ValueError(f"{path}: not a JSON file ({reason})") from None
+    try:
+        usable = all("task_group" in task and isinstance(task["task_id"], int)
+                     and isinstance(task["metrics"]["successes"], list) for task in info["per_task"])
+    except (KeyError, TypeError):
+        usable = False
+    if not usable:
+        raise ValueError(f"{path}: not a lerobot-eval {EVAL_INFO_NAME} (it needs per_task entries with task_group, "
+                         "task_id and metrics.successes)")
+    return info
+
+
 def join(eval_dir: Path) -> tuple[list[dict], dict]:
     """The scored episodes of one lerobot-eval output directory (log records with `episode_ix`), and its meta."""
-    info = json.loads((eval_dir / EVAL_INFO_NAME).read_text())
+    info = read_eval_info(eval_dir / EVAL_INFO_NAME)
     log_path = eval_dir / EPISODE_LOG_NAME
     if not log_path.exists():
         raise FileNotFoundError(f"{log_path} is missing: run the evaluation with the tavis env's episode log")

@@ -118,7 +118,7 @@ def test_fixed_camera_modes_hold_the_neck_at_zero(small_env, camera_mode):
     ({"split": "ood_spatial"}, "split of task 'tabletop' must be one of"),
     ({"image_size": (480,)}, "image_size must be"),
     ({"image_size": (4, 4)}, "image_size must be within"),
-    ({"episode_length_s": 0}, "episode_length_s must be > 0"),
+    ({"episode_length_s": 0}, "episode_length_s must be a finite number of seconds, at least one step at 20 fps"),
     ({"fps": 25}, "fps must divide the 60 Hz control rate"),
     ({"cameras": ("head", "belly")}, "cameras must be distinct names among"),
 ])
