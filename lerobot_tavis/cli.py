@@ -56,7 +56,7 @@ def _report(args: argparse.Namespace) -> None:
 
 def _record(args: argparse.Namespace) -> None:
     from lerobot_tavis.dataset_tools.record import RecordConfig, record
-    from lerobot_tavis.envs.config import expand_tasks
+    from lerobot_tavis.envs.tasks.catalog import expand_tasks
 
     tasks = tuple(t for group in expand_tasks(",".join(args.tasks or [args.suite])).values() for t in group)
     manifest = record(RecordConfig(out_dir=Path(args.out), robot=args.robot, tasks=tasks,
