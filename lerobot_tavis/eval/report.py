@@ -69,15 +69,23 @@ class Cell:
         }
 
 
+# What the report reads from every episode record (the episode log writes more).
+RECORD_FIELDS = ("robot", "suite", "task", "task_id", "split", "camera_mode", "seed", "success")
+
+
 def read_episode_log(path: Path) -> list[dict]:
     records = []
     for number, line in enumerate(path.read_text().splitlines(), start=1):
         if not line.strip():
             continue
         try:
-            records.append(json.loads(line))
+            record = json.loads(line)
         except json.JSONDecodeError as error:
             raise ValueError(f"{path}:{number}: not a JSON line ({error.msg})") from None
+        missing = [name for name in RECORD_FIELDS if not isinstance(record, dict) or name not in record]
+        if missing:
+            raise ValueError(f"{path}:{number}: not an episode record (missing {', '.join(missing)})")
+        records.append(record)
     return records
 
 

@@ -99,6 +99,22 @@ def test_a_malformed_eval_info_is_reported_with_its_file_name(tmp_path, content,
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["episodes.jsonl", "eval_info.json", "tavis_head__id"]
 
 
+@pytest.mark.parametrize("line,problem", [
+    ("{not json", "not a JSON line"),
+    ('{"suite": "tavis_head", "task_id": 0}', "not an episode record (missing robot, task, split, camera_mode, seed, "
+                                             "success)"),
+    ("[1]", "not an episode record"),
+])
+def test_a_damaged_episode_log_line_is_reported_with_its_place(tmp_path, line, problem):
+    cell = tmp_path / "tavis_head__id"
+    cell.mkdir()
+    (cell / "eval_info.json").write_text(
+        '{"per_task": [{"task_group": "tavis_head", "task_id": 0, "metrics": {"successes": [true]}}]}')
+    (cell / "episodes.jsonl").write_text(line + "\n")
+    message = _refused(["report", str(tmp_path)])
+    assert message.startswith(f"tavis report: error: {cell / 'episodes.jsonl'}:1: {problem}")
+
+
 @pytest.mark.parametrize("kwargs,message", [
     ({"episode_length_s": float("inf")}, "episode_length_s must be a finite number of seconds, at least one step "
                                          "at 20 fps (0.05 s), got inf"),
