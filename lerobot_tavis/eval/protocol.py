@@ -2,28 +2,25 @@
 
 Cells are suite x split (`id`, `ood_spatial`, `ood_init_pose`), 96 episodes per task by default, seeds from 1000
 as lerobot-eval uses them. A policy is evaluated through LeRobot's own `eval_main` (one lerobot-eval run per
-cell); the demonstrators (`expert=True`) play the same episodes through the same env and episode log. Each cell
-is written to a temporary directory and moved into place when complete, so a re-run skips finished cells.
-The report (`tavis report`) is written at the end.
+cell); the demonstrators play the same episodes through the same env and episode log, as (cell, task, seed chunk)
+jobs over all workers (`expert_runs`). Each cell is written to a temporary directory and moved into place when
+complete, so a re-run skips finished cells (and, for the demonstrators, finished chunks). `wall_clock_s.txt` in a
+cell is the time from the start of the command to the cell's completion. The report (`tavis report`) is written at
+the end.
 """
 
 from __future__ import annotations
 
-import json
-import multiprocessing
-import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
-
-from tqdm import tqdm
 
 from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.physics import POLICY_HZ
-from lerobot_tavis.envs.tasks.catalog import expand_tasks
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
+from lerobot_tavis.eval.expert_runs import run_expert_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
 START_SEED = 1000
@@ -52,8 +49,9 @@ class ProtocolConfig:
     policy_path: str | None = None  # None: the scripted demonstrators
     batch_size: int = 1
     device: str = "cpu"
-    workers: int = 1  # demonstrators: tasks of a cell in parallel processes
+    workers: int = 1  # demonstrators: processes playing (cell, task, seed chunk) jobs
     seed: int = START_SEED
+    chunk_episodes: int = 8  # demonstrators: consecutive seeds per job
 
     def __post_init__(self):
         object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
@@ -61,6 +59,7 @@ class ProtocolConfig:
         checks.integer("batch_size", self.batch_size, 1)
         checks.integer("workers", self.workers, 1)
         checks.integer("seed", self.seed, 0)
+        checks.integer("chunk_episodes", self.chunk_episodes, 1)
         checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, POLICY_HZ)
 
@@ -68,18 +67,20 @@ class ProtocolConfig:
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:
     cfg.out_dir.mkdir(parents=True, exist_ok=True)
     cells = [Cell(suite, split) for split in cfg.splits for suite in cfg.suites]
+    pending = []
     for cell in cells:
-        final = cfg.out_dir / cell.name
-        if (final / EVAL_INFO_NAME).exists():
+        if (cfg.out_dir / cell.name / EVAL_INFO_NAME).exists():
             print(f"{cell.name}: done already, skipped")
-            continue
-        start = time.perf_counter()
-        with staged_directory(final, overwrite=True) as partial:  # an unfinished cell is replaced
+        else:
+            pending.append(cell)
+    start = time.perf_counter()
+    if cfg.policy_path is None:
+        run_expert_cells(cfg, pending)
+        return write_report(cfg.out_dir)
+    for cell in pending:
+        with staged_directory(cfg.out_dir / cell.name, overwrite=True) as partial:  # an unfinished cell is replaced
             partial.mkdir()
-            if cfg.policy_path is None:
-                _run_expert_cell(cfg, cell, partial)
-            else:
-                _run_policy_cell(cfg, cell, partial)
+            _run_policy_cell(cfg, cell, partial)
             (partial / "wall_clock_s.txt").write_text(f"{time.perf_counter() - start:.1f}\n")
         print(f"{cell.name}: {time.perf_counter() - start:.0f} s")
     return write_report(cfg.out_dir)
@@ -102,42 +103,3 @@ def _run_policy_cell(cfg: ProtocolConfig, cell: Cell, out: Path) -> None:
     eval_main(EvalPipelineConfig(env=env, eval=EvalConfig(n_episodes=cfg.n_episodes, batch_size=cfg.batch_size,
                                                           use_async_envs=cfg.batch_size > 1),
                                  policy=policy, output_dir=out, seed=cfg.seed))
-
-
-def _run_expert_cell(cfg: ProtocolConfig, cell: Cell, out: Path) -> None:
-    tasks = expand_tasks(cell.suite)[cell.suite]
-    jobs = [(cfg, cell, task_id, task, out / f".{task}.jsonl") for task_id, task in enumerate(tasks)]
-    if cfg.workers > 1:
-        with multiprocessing.get_context("spawn").Pool(min(cfg.workers, len(jobs))) as pool:
-            successes = pool.map(_expert_task, jobs)
-    else:
-        successes = [_expert_task(job) for job in jobs]
-    with open(out / EPISODE_LOG_NAME, "w") as log:
-        for *_, part in jobs:
-            log.write(part.read_text())
-            part.unlink()
-    per_task = [{"task_group": cell.suite, "task_id": task_id,
-                 "metrics": {"successes": ok, "sum_rewards": [float(s) for s in ok],
-                             "max_rewards": [float(s) for s in ok], "video_paths": []}}
-                for task_id, ok in enumerate(successes)]
-    flat = [s for ok in successes for s in ok]
-    summary = {"pc_success": 100.0 * sum(flat) / len(flat), "n_episodes": len(flat)}
-    info = {"per_task": per_task, "per_group": {cell.suite: summary}, "overall": summary,
-            "policy": "scripted demonstrators"}
-    (out / EVAL_INFO_NAME).write_text(json.dumps(info, indent=2) + "\n")
-
-
-def _expert_task(job) -> list[bool]:
-    """Episodes seed .. seed + n - 1 of one task with its demonstrator; returns LeRobot-style successes."""
-    cfg, cell, task_id, task, log_path = job
-    os.environ.setdefault("MUJOCO_GL", "egl")
-    from lerobot_tavis.envs.factory import make_tavis_env
-    from lerobot_tavis.experts.registry import run_episode
-
-    env = make_tavis_env(task, cfg.robot, cfg.camera_mode, cell.split, cfg.image_size, cfg.episode_length_s,
-                         str(log_path), suite=cell.suite, task_id=task_id)
-    successes = []
-    for ix in tqdm(range(cfg.n_episodes), desc=f"{cell.name} {task}", unit="ep", position=task_id):
-        successes.append(run_episode(env, cfg.seed + ix).success)
-    env.close()
-    return successes

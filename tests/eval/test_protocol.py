@@ -29,6 +29,38 @@ def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
     assert not list(tmp_path.glob(".*partial*"))
 
 
+def _cell_files(root, cell="tavis_hands__id"):
+    return ((root / cell / "episodes.jsonl").read_text(), json.loads((root / cell / "eval_info.json").read_text()))
+
+
+def test_expert_results_do_not_depend_on_workers_or_chunking(tmp_path):
+    """Chunks of one seed finish in any order over 2 workers; the cell is the same as one process playing all."""
+    common = dict(robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2, image_size=(24, 32))
+    run_protocol(ProtocolConfig(out_dir=tmp_path / "one", workers=1, **common))
+    run_protocol(ProtocolConfig(out_dir=tmp_path / "two", workers=2, chunk_episodes=1, **common))
+    assert _cell_files(tmp_path / "one") == _cell_files(tmp_path / "two")
+    assert not list((tmp_path / "two").glob(".*"))  # the chunks are gone once the cell is written
+
+
+def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
+    """A chunk whose `done` record exists is not played again: its stored outcome is what the cell reports."""
+    cfg = ProtocolConfig(out_dir=tmp_path, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=1,
+                         image_size=(24, 32), chunk_episodes=1)
+    work = tmp_path / ".tavis_hands__id.chunks"
+    work.mkdir(parents=True)
+    stored = {"robot": "gr1t2", "suite": "tavis_hands", "task": "peeking_box", "task_id": 0, "split": "id",
+              "camera_mode": "head_wrist", "seed": 1000, "success": False, "length_steps": 400, "prompt": "stored"}
+    (work / "00_peeking_box_0001000.jsonl").write_text(json.dumps(stored) + "\n")
+    (work / "00_peeking_box_0001000.done.json").write_text(json.dumps({"successes": [False]}))
+    (work / "01_occluded_reach_0001000.jsonl").write_text("half a line of a killed chunk")  # no done record
+    run_protocol(cfg)
+    log, info = _cell_files(tmp_path)
+    records = [json.loads(line) for line in log.splitlines()]
+    assert [r["task"] for r in records] == ["peeking_box", "occluded_reach", "blocked_clutter_pick_cube"]
+    assert records[0]["prompt"] == "stored" and info["per_task"][0]["metrics"]["successes"] == [False]
+    assert records[1]["prompt"] != "stored" and not work.exists()
+
+
 def _diffusion_checkpoint(path, image_size):
     from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
     from lerobot.policies.factory import make_policy, make_pre_post_processors
