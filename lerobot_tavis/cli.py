@@ -32,19 +32,41 @@ def _gallery(args: argparse.Namespace) -> None:
         print(path)
 
 
+# `tavis eval` settings when neither the command line nor the checkpoint's training config gives them.
+EVAL_DEFAULTS = {"robot": "gr1t2", "camera_mode": DEFAULT_CAMERA_MODE, "image_size": (480, 640)}
+
+
 def _eval(args: argparse.Namespace) -> None:
     from pathlib import Path
 
-    from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
+    from lerobot_tavis.eval.protocol import ProtocolConfig, checkpoint_env, run_protocol
 
     if bool(args.policy) == bool(args.expert):
         raise ValueError("give exactly one of --policy PATH and --expert")
-    cfg = ProtocolConfig(out_dir=Path(args.out), robot=args.robot, suites=tuple(args.suite), splits=tuple(args.splits),
-                         n_episodes=args.episodes, camera_mode=args.camera_mode,
-                         image_size=_image_size(args.image_size), policy_path=args.policy,
-                         batch_size=args.batch_size, device=args.device, workers=args.workers, seed=args.seed)
+    trained = {}
+    if args.policy:
+        if Path(args.policy).exists():
+            trained = checkpoint_env(args.policy)
+        elif not _looks_like_repo_id(args.policy):
+            raise FileNotFoundError(f"--policy {args.policy}: no such checkpoint directory")
+    given = {"robot": args.robot, "camera_mode": args.camera_mode,
+             "image_size": _image_size(args.image_size) if args.image_size else None}
+    settings = {**EVAL_DEFAULTS, **trained, **{key: value for key, value in given.items() if value is not None}}
+    cfg = ProtocolConfig(out_dir=Path(args.out), suites=tuple(args.suite), splits=tuple(args.splits),
+                         n_episodes=args.episodes, policy_path=args.policy, batch_size=args.batch_size,
+                         device=args.device, workers=args.workers, seed=args.seed, **settings)
     for path in run_protocol(cfg):
         print(path)
+
+
+def _looks_like_repo_id(text: str) -> bool:
+    from lerobot_tavis.checks import repo_id
+
+    try:
+        repo_id(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _report(args: argparse.Namespace) -> None:
@@ -170,14 +192,15 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate = commands.add_parser("eval", help="the 96-episode protocol for a policy checkpoint or the demonstrators")
     evaluate.add_argument("--policy", help="policy checkpoint directory (pretrained_model)")
     evaluate.add_argument("--expert", action="store_true", help="evaluate the scripted demonstrators instead")
-    evaluate.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
+    evaluate.add_argument("--robot", choices=["gr1t2", "reachy2"], help="default: the checkpoint's, else gr1t2")
     evaluate.add_argument("--suite", nargs="+", default=["tavis_head"], choices=["tavis_head", "tavis_hands"])
     evaluate.add_argument("--splits", nargs="+", default=["id", "ood_spatial", "ood_init_pose"],
                           choices=["id", "ood_spatial", "ood_init_pose"])
     evaluate.add_argument("--episodes", type=int, default=96, help="episodes per task and split (default 96)")
-    evaluate.add_argument("--camera-mode", default=DEFAULT_CAMERA_MODE, choices=[*CAMERA_MODES, *RENAMED_MODES],
-                          help="head_wrist (default) and fixed_wrist are the paper's headcam and fixedcam conditions")
-    evaluate.add_argument("--image-size", default="480x640")
+    evaluate.add_argument("--camera-mode", choices=[*CAMERA_MODES, *RENAMED_MODES],
+                          help="default: the checkpoint's, else head_wrist; head_wrist and fixed_wrist are the "
+                          "paper's headcam and fixedcam conditions")
+    evaluate.add_argument("--image-size", help="HxW; default: the checkpoint's, else 480x640")
     evaluate.add_argument("--batch-size", type=int, default=1, help="parallel envs per task (policy runs)")
     evaluate.add_argument("--device", default="cpu")
     evaluate.add_argument("--workers", type=int, default=1, help="parallel processes (demonstrator runs)")

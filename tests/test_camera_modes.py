@@ -2,7 +2,7 @@
 
 import pytest
 
-from lerobot_tavis.cli import build_parser
+from lerobot_tavis.cli import EVAL_DEFAULTS
 from lerobot_tavis.envs.config import TavisEnvConfig
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_MODES, PAPER_CONDITIONS, resolve_camera_mode
@@ -23,7 +23,7 @@ def test_every_entry_point_defaults_to_the_papers_headcam_condition(tmp_path):
     assert config.camera_mode == "head_wrist"
     assert sorted(k for k in config.features if k.startswith("pixels/")) == sorted(f"pixels/{c}" for c in PAPER_HEADCAM)
     assert ProtocolConfig(out_dir=tmp_path).camera_mode == "head_wrist"
-    assert build_parser().parse_args(["eval", "--expert", "--out", str(tmp_path)]).camera_mode == "head_wrist"
+    assert EVAL_DEFAULTS["camera_mode"] == "head_wrist"  # tavis eval, when the checkpoint does not say otherwise
 
 
 @pytest.mark.parametrize("old,new,cameras", [("headcam", "head_only", ("head",)),

@@ -11,6 +11,7 @@ the end.
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -62,6 +63,24 @@ class ProtocolConfig:
         checks.integer("chunk_episodes", self.chunk_episodes, 1)
         checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, POLICY_HZ)
+
+
+def checkpoint_env(policy_path: str | Path) -> dict:
+    """The tavis env settings a checkpoint was trained with (robot, camera_mode, image_size), read from the
+    `train_config.json` lerobot-train saves beside it; empty when there is none or it is not a tavis run."""
+    path = Path(policy_path) / "train_config.json"
+    if not path.is_file():
+        return {}
+    try:
+        env = json.loads(path.read_text()).get("env") or {}
+    except json.JSONDecodeError as error:
+        raise ValueError(f"{path}: not a JSON file ({error.msg})") from None
+    if env.get("type") != "tavis":
+        return {}
+    found = {key: env[key] for key in ("robot", "camera_mode", "image_size") if key in env}
+    if "image_size" in found:
+        found["image_size"] = tuple(found["image_size"])
+    return found
 
 
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:

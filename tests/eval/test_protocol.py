@@ -5,6 +5,10 @@ import os
 import subprocess
 import sys
 
+import pytest
+
+from lerobot_tavis.cli import main
+from lerobot_tavis.eval import protocol
 from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
 
 
@@ -59,6 +63,34 @@ def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     assert [r["task"] for r in records] == ["peeking_box", "occluded_reach", "blocked_clutter_pick_cube"]
     assert records[0]["prompt"] == "stored" and info["per_task"][0]["metrics"]["successes"] == [False]
     assert records[1]["prompt"] != "stored" and not work.exists()
+
+
+def _trained_checkpoint(path, env):
+    path.mkdir(parents=True)
+    (path / "train_config.json").write_text(json.dumps({"env": env, "policy": {"type": "diffusion"}}))
+    return path
+
+
+@pytest.mark.parametrize("extra,expected", [
+    ([], ("reachy2", "fixed_wrist", (120, 160))),  # all from the checkpoint's training config
+    (["--camera-mode", "head_only", "--image-size", "96x128"], ("reachy2", "head_only", (96, 128))),  # given wins
+])
+def test_tavis_eval_takes_robot_camera_mode_and_image_size_from_the_checkpoint(tmp_path, monkeypatch, extra,
+                                                                                expected):
+    checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {
+        "type": "tavis", "robot": "reachy2", "camera_mode": "fixed_wrist", "image_size": [120, 160]})
+    seen = []
+    monkeypatch.setattr(protocol, "run_protocol", lambda cfg: seen.append(cfg) or [])
+    main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), *extra])
+    (cfg,) = seen
+    assert (cfg.robot, cfg.camera_mode, cfg.image_size) == expected
+
+
+def test_a_missing_checkpoint_path_says_so(tmp_path):
+    missing = tmp_path / "outputs" / "train" / "checkpoints" / "last" / "pretrained_model"
+    with pytest.raises(SystemExit, match=f"--policy {missing}: no such checkpoint directory"):
+        main(["eval", "--policy", str(missing), "--out", str(tmp_path / "out")])
+    assert not (tmp_path / "out").exists()
 
 
 def _diffusion_checkpoint(path, image_size):
