@@ -4,7 +4,9 @@ All chunks of all pending cells go to one pool, so every core stays busy whateve
 episode's outcome depends only on its task, split and seed, and each cell is assembled in a fixed order (task, then
 seed) once its last chunk is done, so the results do not depend on the number of workers or on finishing order.
 Finished chunks are kept in the hidden folder `.<cell>.chunks/` (their episode log and a `done` record), so a
-killed run resumes at chunk granularity; `tavis report` never reads hidden folders.
+killed run resumes at chunk granularity; `tavis report` never reads hidden folders. Nothing is rendered: the
+demonstrators act on the simulator state, so pixels cannot change an outcome (the camera mode still fixes whether
+the neck moves).
 """
 
 from __future__ import annotations
@@ -102,7 +104,7 @@ def _play_chunk(cfg, chunk: Chunk, work: Path) -> Chunk:
     key = (chunk.task, chunk.split)
     if key not in _ENVS:
         _ENVS[key] = make_tavis_env(chunk.task, cfg.robot, cfg.camera_mode, chunk.split, cfg.image_size,
-                                    cfg.episode_length_s)
+                                    cfg.episode_length_s, cameras=())  # the demonstrators read the state
     work.mkdir(parents=True, exist_ok=True)
     log_path = work / f"{chunk.stem}.jsonl"
     log_path.unlink(missing_ok=True)  # what a killed run left of this chunk
