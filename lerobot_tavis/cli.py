@@ -54,9 +54,24 @@ def _eval(args: argparse.Namespace) -> None:
     settings = {**EVAL_DEFAULTS, **trained, **{key: value for key, value in given.items() if value is not None}}
     cfg = ProtocolConfig(out_dir=Path(args.out), suites=tuple(args.suite), splits=tuple(args.splits),
                          n_episodes=args.episodes, policy_path=args.policy, batch_size=args.batch_size,
-                         device=args.device, workers=args.workers, seed=args.seed, **settings)
+                         device=args.device, workers=args.workers, seed=args.seed,
+                         episode_length_s=args.episode_length_s,
+                         policy_options=tuple(_policy_option(text) for text in args.policy_option), **settings)
     for path in run_protocol(cfg):
         print(path)
+
+
+def _policy_option(text: str) -> tuple[str, object]:
+    """`num_inference_steps=10` -> ("num_inference_steps", 10): values are read as JSON, else kept as text."""
+    import json
+
+    name, sign, value = text.partition("=")
+    if not (sign and name.strip()):
+        raise ValueError(f"--policy-option must be FIELD=VALUE, e.g. num_inference_steps=10, got {text!r}")
+    try:
+        return name.strip(), json.loads(value)
+    except json.JSONDecodeError:
+        return name.strip(), value
 
 
 def _looks_like_repo_id(text: str) -> bool:
@@ -203,6 +218,10 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--image-size", help="HxW; default: the checkpoint's, else 480x640")
     evaluate.add_argument("--batch-size", type=int, default=1, help="parallel envs per task (policy runs)")
     evaluate.add_argument("--device", default="cpu")
+    evaluate.add_argument("--episode-length-s", type=float, default=20.0, help="seconds per episode (default 20)")
+    evaluate.add_argument("--policy-option", action="append", default=[], metavar="FIELD=VALUE",
+                          help="set a field of the checkpoint's policy config, e.g. num_inference_steps=10 or "
+                          "use_amp=true (repeatable)")
     evaluate.add_argument("--workers", type=int, default=1, help="parallel processes (demonstrator runs)")
     evaluate.add_argument("--seed", type=int, default=1000, help="first episode seed (lerobot-eval's default)")
     evaluate.add_argument("--out", required=True, help="output directory; finished cells are skipped on re-runs")

@@ -53,6 +53,7 @@ class ProtocolConfig:
     workers: int = 1  # demonstrators: processes playing (cell, task, seed chunk) jobs
     seed: int = START_SEED
     chunk_episodes: int = 8  # demonstrators: consecutive seeds per job
+    policy_options: tuple[tuple[str, object], ...] = ()  # (field, value) set on the checkpoint's policy config
 
     def __post_init__(self):
         object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
@@ -116,6 +117,10 @@ def _run_policy_cell(cfg: ProtocolConfig, cell: Cell, out: Path) -> None:
     policy = PreTrainedConfig.from_pretrained(cfg.policy_path)
     policy.pretrained_path = Path(cfg.policy_path)
     policy.device = cfg.device
+    for name, value in cfg.policy_options:  # e.g. num_inference_steps=10, use_amp=true
+        if not hasattr(policy, name):
+            raise ValueError(f"--policy-option {name}: the {policy.type} policy has no such field")
+        setattr(policy, name, value)
     env = TavisEnvConfig(task=cell.suite, robot=cfg.robot, camera_mode=cfg.camera_mode, split=cell.split,
                          image_size=cfg.image_size, episode_length_s=cfg.episode_length_s,
                          episode_log=str(out / EPISODE_LOG_NAME))

@@ -86,6 +86,27 @@ def test_tavis_eval_takes_robot_camera_mode_and_image_size_from_the_checkpoint(t
     assert (cfg.robot, cfg.camera_mode, cfg.image_size) == expected
 
 
+def test_lerobot_options_pass_through_to_the_policy_and_the_env(tmp_path, monkeypatch):
+    checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {"type": "tavis"})
+    seen = []
+    monkeypatch.setattr(protocol, "run_protocol", lambda cfg: seen.append(cfg) or [])
+    main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), "--episode-length-s", "5",
+          "--policy-option", "num_inference_steps=10", "--policy-option", "use_amp=true",
+          "--policy-option", "noise_scheduler_type=DDIM"])
+    assert seen[0].episode_length_s == 5.0
+    assert seen[0].policy_options == (("num_inference_steps", 10), ("use_amp", True), ("noise_scheduler_type", "DDIM"))
+    with pytest.raises(SystemExit, match="--policy-option must be FIELD=VALUE"):
+        main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), "--policy-option", "steps"])
+
+
+def test_an_unknown_policy_option_names_the_field(tmp_path):
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("id",), n_episodes=1,
+                         image_size=(32, 48), policy_path=str(tmp_path / "ckpt"), policy_options=(("denoise", 3),))
+    with pytest.raises(ValueError, match="--policy-option denoise: the diffusion policy has no such field"):
+        run_protocol(cfg)
+
+
 def test_a_missing_checkpoint_path_says_so(tmp_path):
     missing = tmp_path / "outputs" / "train" / "checkpoints" / "last" / "pretrained_model"
     with pytest.raises(SystemExit, match=f"--policy {missing}: no such checkpoint directory"):
@@ -110,7 +131,8 @@ def _diffusion_checkpoint(path, image_size):
 def test_policy_protocol_runs_through_lerobot_eval(tmp_path):
     _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
     cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("ood_init_pose",),
-                         n_episodes=1, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"))
+                         n_episodes=1, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
+                         policy_options=(("num_inference_steps", 1),))
     run_protocol(cfg)
     results = json.loads((tmp_path / "eval" / "results.json").read_text())
     assert [(c["task"], c["split"], c["n"]) for c in results["cells"]] == [
