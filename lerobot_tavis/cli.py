@@ -37,8 +37,6 @@ EVAL_DEFAULTS = {"robot": "gr1t2", "camera_mode": DEFAULT_CAMERA_MODE, "image_si
 
 
 def _eval(args: argparse.Namespace) -> None:
-    from pathlib import Path
-
     from lerobot_tavis.eval.protocol import ProtocolConfig, checkpoint_env, run_protocol
 
     if bool(args.policy) == bool(args.expert):

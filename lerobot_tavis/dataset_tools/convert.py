@@ -124,8 +124,6 @@ def replayed(cfg: ConvertConfig, entries: Sequence, cameras: Sequence[str],
                 entry, future = pending.popleft()
                 yield entry, *future.result()
         finally:
-            for _, future in pending:
-                future.cancel()
             pool.shutdown(wait=True, cancel_futures=True)
             close_replayers()  # those of this process (workers == 1); a worker's go with its process
 

@@ -49,13 +49,14 @@ def verify_dataset(root: Path, episodes: Sequence[int] | None = None, hold_s: fl
     log_path = Path(root) / CONVERSION_LOG
     if not log_path.is_file():
         raise TavisError(f"{root}: no {CONVERSION_LOG}; only datasets written by `tavis convert` can be replayed")
-    log = {entry["episode_index"]: entry for entry in json.loads(log_path.read_text())["episodes"]}
+    conversion = json.loads(log_path.read_text())
+    log = {entry["episode_index"]: entry for entry in conversion["episodes"]}
     meta = LeRobotDatasetMetadata("local/verify", root=root)
     chosen = sorted(log) if episodes is None else list(episodes)
     unknown = [index for index in chosen if index not in log]
     if unknown:
         raise TavisError(f"{root}: no episodes {unknown}; it holds 0..{len(log) - 1}")
-    zero_neck = json.loads(log_path.read_text()).get("zero_neck", False)
+    zero_neck = conversion.get("zero_neck", False)
     columns = _episode_columns(root)
     return [_replay(meta.robot_type, meta.fps, log[index], columns[index], zero_neck, hold_s, action_shift)
             for index in chosen]

@@ -10,6 +10,7 @@ import multiprocessing
 import os
 from concurrent.futures import Future, ProcessPoolExecutor
 
+from lerobot_tavis import checks
 from lerobot_tavis.process import die_with_parent
 
 
@@ -33,9 +34,7 @@ class InlineExecutor:
 
 def executor(workers: int) -> InlineExecutor | ProcessPoolExecutor:
     """`workers` spawned processes (MuJoCo's EGL contexts and torch do not survive a fork), or inline for one."""
-    if not (isinstance(workers, int) and workers >= 1):
-        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
-    if workers == 1:
+    if checks.integer("workers", workers, 1) == 1:
         return InlineExecutor()
     return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=die_with_parent,
                                initargs=(os.getpid(),))

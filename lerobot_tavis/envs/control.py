@@ -109,8 +109,8 @@ def _within(offset: np.ndarray, radius: float) -> np.ndarray:
     if scale <= radius / 2:  # certainly inside, and its norm cannot overflow
         return offset
     direction = offset / scale
-    distance = scale * np.linalg.norm(direction)
-    return offset if distance <= radius else direction / np.linalg.norm(direction) * radius
+    norm = np.linalg.norm(direction)
+    return offset if scale * norm <= radius else direction / norm * radius
 
 
 def hand_targets(robot: Robot, action: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:

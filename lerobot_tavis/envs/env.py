@@ -32,8 +32,10 @@ SETTLE_SPEED_M_S = 0.005
 WARM_UP_STEPS = 10
 WARM_UP_POSITION_STD_M = 0.10
 WARM_UP_HEAD_STD_RAD = 0.175
-# MuJoCo's instability warnings: it resets the simulation state itself when one fires, so the episode cannot go on.
-INSTABILITY_WARNINGS = ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC")
+# MuJoCo's instability warnings (name, index into MjData.warning): it resets the simulation state itself when one
+# fires, so the episode cannot go on.
+INSTABILITY_WARNINGS = tuple((name, int(getattr(mujoco.mjtWarning, name)))
+                             for name in ("mjWARN_BADQPOS", "mjWARN_BADQVEL", "mjWARN_BADQACC"))
 
 
 class _Sim:
@@ -53,8 +55,8 @@ class _Sim:
 
     def instability(self) -> str | None:
         """The first of MuJoCo's instability warnings raised since the last reset, e.g. "mjWARN_BADQVEL"."""
-        for name in INSTABILITY_WARNINGS:
-            if self.data.warning[int(getattr(mujoco.mjtWarning, name))].number:
+        for name, index in INSTABILITY_WARNINGS:
+            if self.data.warning[index].number:
                 return name
         return None
 
@@ -139,8 +141,6 @@ class TavisEnv(gym.Env):
         applied = sim.controller.set_command(action)
         for _ in range(self._ticks_per_step):
             sim.advance_tick()
-            if sim.instability():
-                break
         self._steps += 1
         unstable = sim.instability()
         if unstable:  # MuJoCo has reset the state: the episode ends, unsuccessful, with the reason

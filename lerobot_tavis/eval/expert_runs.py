@@ -87,8 +87,7 @@ def _completed(workers: int, fn: Callable, jobs: list[tuple]) -> Iterator:
             for future in as_completed(futures):
                 yield future.result()
         finally:
-            for future in futures:
-                future.cancel()
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 _ENVS: dict[tuple, object] = {}  # per process: (task, split) -> its TavisEnv, reused across chunks
