@@ -13,7 +13,8 @@
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `diffusion_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
 #   libraries can be found (PyAV's bundled copy, tools/pyav_ffmpeg.sh), else with PyAV.
-# - eval: lerobot-eval on every saved checkpoint not yet evaluated (seeds from 1000), then `tavis report`.
+# - eval: lerobot-eval on every complete checkpoint not yet evaluated (seeds from 1000), then `tavis report`; it
+#   can run beside `train`, which marks a checkpoint complete by pointing `checkpoints/last` at it.
 # - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for 1500 steps and
 #   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
 #   on points at a data or alignment bug, not at too little training.
@@ -72,8 +73,10 @@ case "${1:-}" in
     time train "$WORK/dataset_$CONDITION" "$WORK/train_$CONDITION" ${STEPS:+--steps=$STEPS} \
       ${SAVE_FREQ:+--save_freq=$SAVE_FREQ}
     ;;
-  eval)
+  eval)  # every complete checkpoint (up to the one `last` points at), so it may run while training goes on
+    last=$(basename "$(readlink "$WORK/train_$CONDITION/checkpoints/last" 2>/dev/null)") || exit 0
     for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
+      (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
       out="$WORK/eval_$CONDITION/step_$((10#$(basename "$checkpoint")))"
       [ -f "$out/eval_info.json" ] || time evaluate "$checkpoint" "$out" 1000 "$EVAL_EPISODES"
     done

@@ -58,3 +58,10 @@ def repo_id(value, field: str = "repo_id") -> str:
                                 f"digits, '-', '_' or '.' (not '--' or '..', nor '-' or '.' at either end), "
                                 f"got {value!r}")
     return value
+
+
+def choice(field: str, value, allowed: tuple) -> object:
+    """`value` if it is one of `allowed`."""
+    if value not in allowed:
+        raise FieldError(field, f"must be one of {', '.join(map(str, allowed))}, got {value!r}")
+    return value

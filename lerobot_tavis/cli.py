@@ -10,6 +10,7 @@ import threading
 from pathlib import Path
 
 from lerobot_tavis.dataset_tools.features import STORAGES
+from lerobot_tavis.dataset_tools.workers import BACKENDS
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, RENAMED_MODES
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 from lerobot_tavis.errors import FieldError, TavisError
@@ -52,8 +53,8 @@ def _eval(args: argparse.Namespace) -> None:
     settings = {**EVAL_DEFAULTS, **trained, **{key: value for key, value in given.items() if value is not None}}
     cfg = ProtocolConfig(out_dir=Path(args.out), suites=tuple(args.suite), splits=tuple(args.splits),
                          n_episodes=args.episodes, policy_path=args.policy, batch_size=args.batch_size,
-                         device=args.device, workers=args.workers, seed=args.seed,
-                         episode_length_s=args.episode_length_s,
+                         device=args.device, workers=args.workers, seed=args.seed, backend=args.backend,
+                         chunk_episodes=args.chunk_episodes, episode_length_s=args.episode_length_s,
                          policy_options=tuple(_policy_option(text) for text in args.policy_option), **settings)
     for path in run_protocol(cfg):
         print(path)
@@ -97,7 +98,7 @@ def _record(args: argparse.Namespace) -> None:
     manifest = record(RecordConfig(out_dir=Path(args.out), robot=args.robot, tasks=tasks,
                                    episodes_per_task=args.episodes_per_task, split=args.split,
                                    keep_failures=args.keep_failures, seed_start=args.seed_start,
-                                   workers=args.workers))
+                                   workers=args.workers, backend=args.backend))
     for task, count in manifest.counts().items():
         print(f"{task}: {count['kept']} kept, {count['discarded']} discarded")
 
@@ -220,7 +221,12 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--policy-option", action="append", default=[], metavar="FIELD=VALUE",
                           help="set a field of the checkpoint's policy config, e.g. num_inference_steps=10 or "
                           "use_amp=true (repeatable)")
-    evaluate.add_argument("--workers", type=int, default=1, help="parallel processes (demonstrator runs)")
+    evaluate.add_argument("--workers", type=int, default=1,
+                          help="(cell, task, seed chunk) jobs at once; with a policy on a GPU they share it")
+    evaluate.add_argument("--chunk-episodes", type=int,
+                          help="consecutive episodes per job (default 8 for the demonstrators, 32 for a policy)")
+    evaluate.add_argument("--backend", default="local", choices=BACKENDS,
+                          help="local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)")
     evaluate.add_argument("--seed", type=int, default=1000, help="first episode seed (lerobot-eval's default)")
     evaluate.add_argument("--out", required=True, help="output directory; finished cells are skipped on re-runs")
     evaluate.set_defaults(run=_eval, options={"n_episodes": "--episodes"})
@@ -233,7 +239,9 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--episodes-per-task", type=int, default=160, help="kept episodes per task (default 160)")
     rec.add_argument("--keep-failures", action="store_true", help="keep failed episodes too (default: discard)")
     rec.add_argument("--seed-start", type=int, default=100_000, help="first seed (evaluation uses 1000..)")
-    rec.add_argument("--workers", type=int, default=1, help="parallel processes")
+    rec.add_argument("--workers", type=int, default=1, help="episodes at once (local backend: processes)")
+    rec.add_argument("--backend", default="local", choices=BACKENDS,
+                     help="local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)")
     rec.add_argument("--out", required=True, help="raw directory; re-running resumes it")
     rec.set_defaults(run=_record)
 

@@ -21,7 +21,7 @@ from tqdm import tqdm
 
 from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
-from lerobot_tavis.dataset_tools.workers import executor
+from lerobot_tavis.dataset_tools.workers import BACKENDS, executor
 
 RECORD_FPS = 60
 
@@ -35,13 +35,15 @@ class RecordConfig:
     split: str = "id"
     keep_failures: bool = False
     seed_start: int = 100_000
-    workers: int = 1
+    workers: int = 1  # episodes in flight at once (local backend: worker processes)
     max_attempts_factor: float = 3.0
+    backend: str = "local"  # or "ray" (dataset_tools.workers)
 
     def __post_init__(self):
         checks.integer("episodes_per_task", self.episodes_per_task, 1)
         checks.integer("workers", self.workers, 1)
         checks.integer("seed_start", self.seed_start, 0)
+        checks.choice("backend", self.backend, BACKENDS)
         if not self.tasks:
             raise ValueError("tasks must name at least one task")
 
@@ -62,7 +64,7 @@ def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
     in_flight = dict.fromkeys(cfg.tasks, 0)
     seeds = {task: _free_seeds(cfg, manifest, task) for task in cfg.tasks}
     total = cfg.episodes_per_task * len(cfg.tasks)
-    with executor(cfg.workers) as pool, tqdm(total=total, initial=sum(map(manifest.kept, cfg.tasks)),
+    with executor(cfg.workers, cfg.backend) as pool, tqdm(total=total, initial=sum(map(manifest.kept, cfg.tasks)),
                                               desc=f"record {cfg.robot}", unit="ep", disable=not progress) as bar:
         def refill() -> None:
             for task in cfg.tasks:
@@ -71,16 +73,18 @@ def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
                     if seed is None:
                         break
                     in_flight[task] += 1
-                    pending.add(pool.submit(record_episode, cfg.out_dir, cfg.robot, task, cfg.split, seed,
-                                            cfg.keep_failures))
+                    pending.add(pool.submit(record_episode, cfg.robot, task, cfg.split, seed, cfg.keep_failures))
 
         refill()
         while pending:
             done, _ = wait(pending, return_when=FIRST_COMPLETED)
             for future in done:
                 pending.remove(future)
-                entry = future.result()
+                entry, episode = future.result()
                 in_flight[entry.task] -= 1
+                if episode is not None:
+                    entry.file = episode_filename(entry.task, entry.seed)
+                    entry.sha256 = save_episode(cfg.out_dir / entry.file, episode)
                 manifest.add(entry)
                 manifest.save(cfg.out_dir)
                 bar.update(bool(entry.file))
@@ -117,8 +121,10 @@ def _free_seeds(cfg: RecordConfig, manifest: Manifest, task: str) -> Iterator[in
             yield seed
 
 
-def record_episode(out_dir: Path, robot: str, task: str, split: str, seed: int, keep_failures: bool) -> ManifestEntry:
-    """Play one demonstrator episode at 60 Hz; write it if kept. Runs in a worker process."""
+def record_episode(robot: str, task: str, split: str, seed: int,
+                   keep_failures: bool) -> tuple[ManifestEntry, RawEpisode | None]:
+    """Play one demonstrator episode at 60 Hz; returns its manifest entry and, if kept, the episode (the calling
+    process writes it). Runs in a worker."""
     from lerobot_tavis.experts.registry import run_episode
 
     env = _env(robot, task, split)
@@ -132,12 +138,9 @@ def record_episode(out_dir: Path, robot: str, task: str, split: str, seed: int, 
     result = run_episode(env, seed, on_step=snapshot)
     entry = ManifestEntry(task, seed, result.success, result.length_steps)
     if not (result.success or keep_failures):
-        return entry
-    episode = RawEpisode(robot, task, split, seed, env.task_description, RECORD_FPS, result.success,
-                         result.actions, np.array(qpos), np.array(qvel), np.array(task_state))
-    entry.file = episode_filename(task, seed)
-    entry.sha256 = save_episode(out_dir / entry.file, episode)
-    return entry
+        return entry, None
+    return entry, RawEpisode(robot, task, split, seed, env.task_description, RECORD_FPS, result.success,
+                             result.actions, np.array(qpos), np.array(qvel), np.array(task_state))
 
 
 _ENVS: dict[tuple[str, str, str], object] = {}

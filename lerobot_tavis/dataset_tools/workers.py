@@ -1,7 +1,14 @@
-"""Process pools for the dataset tools: `workers` spawned processes, or the calling process when workers == 1.
+"""Where jobs run: the calling process, local worker processes, or a Ray cluster.
 
-A worker never outlives the process that started it (`lerobot_tavis.process`), so no orphan keeps recording or
-holds staging files.
+Every job here is a picklable call whose result depends only on its arguments and is returned to the calling
+process, which alone writes files. So the backend, the number of workers and the order in which jobs finish never
+change what is written, and a Ray cluster needs no filesystem shared with the caller.
+
+- `local`: `workers` spawned processes, or the calling process when workers == 1. A worker never outlives the
+  process that started it (`lerobot_tavis.process`), so no orphan keeps recording or holds staging files.
+- `ray`: Ray tasks, on the cluster named by `RAY_ADDRESS` (`ray start --head` on one node, `ray start
+  --address=...` on the others), else on a Ray instance started on this machine for the run. Install with
+  `pip install 'lerobot_env_tavis[ray]'`; docs/scaling.md.
 """
 
 from __future__ import annotations
@@ -11,7 +18,10 @@ import os
 from concurrent.futures import Future, ProcessPoolExecutor
 
 from lerobot_tavis import checks
+from lerobot_tavis.errors import TavisError
 from lerobot_tavis.process import die_with_parent
+
+BACKENDS = ("local", "ray")
 
 
 class InlineExecutor:
@@ -32,10 +42,58 @@ class InlineExecutor:
         return None
 
 
-def executor(workers: int) -> InlineExecutor | ProcessPoolExecutor:
-    """`workers` spawned processes (MuJoCo's EGL contexts and torch do not survive a fork), or inline for one."""
-    if checks.integer("workers", workers, 1) == 1:
+class RayExecutor:
+    """`submit` sends the call to Ray as a task needing `cpus` CPUs and `gpus` GPUs (a fraction shares one GPU).
+
+    Ray schedules as many tasks at once as the cluster's resources allow. Worker processes get `MUJOCO_GL` from
+    this process (default egl).
+    """
+
+    def __init__(self, cpus: float = 1.0, gpus: float = 0.0):
+        try:
+            import ray
+        except ImportError:
+            raise TavisError("--backend ray needs Ray: pip install 'lerobot_env_tavis[ray]'") from None
+        self._ray = ray
+        self._options = {"num_cpus": cpus, "num_gpus": gpus, "max_retries": 0}
+        self._pending: list = []
+        self._remote: dict = {}  # fn -> its Ray remote function, registered once
+        self._started_ray = False
+
+    def __enter__(self):
+        if not self._ray.is_initialized():
+            env = {"MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+            self._ray.init(address=os.environ.get("RAY_ADDRESS"), runtime_env={"env_vars": env},
+                           log_to_driver=False, include_dashboard=False, logging_level="ERROR")
+            self._started_ray = True
+        return self
+
+    def submit(self, fn, *args) -> Future:
+        if fn not in self._remote:
+            self._remote[fn] = self._ray.remote(**self._options)(fn)
+        ref = self._remote[fn].remote(*args)
+        self._pending.append(ref)
+        return ref.future()
+
+    def shutdown(self, wait: bool = True, cancel_futures: bool = False) -> None:
+        if cancel_futures:
+            for ref in self._pending:
+                self._ray.cancel(ref, force=True)
+        self._pending.clear()
+
+    def __exit__(self, *exc) -> None:
+        self.shutdown(cancel_futures=True)
+        if self._started_ray:
+            self._ray.shutdown()
+
+
+def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0):
+    """The pool for `backend`: local spawned processes (MuJoCo's EGL contexts and torch do not survive a fork), or
+    inline for one worker; Ray ignores `workers` and runs what the cluster's resources allow."""
+    checks.integer("workers", workers, 1)
+    if checks.choice("backend", backend, BACKENDS) == "ray":
+        return RayExecutor(gpus=gpus_per_job)
+    if workers == 1:
         return InlineExecutor()
     return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=die_with_parent,
                                initargs=(os.getpid(),))
-

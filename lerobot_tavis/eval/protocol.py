@@ -1,27 +1,24 @@
 """`tavis eval`: the benchmark protocol for one policy checkpoint (or the demonstrators) on one robot.
 
 Cells are suite x split (`id`, `ood_spatial`, `ood_init_pose`), 96 episodes per task by default, seeds from 1000
-as lerobot-eval uses them. A policy is evaluated through LeRobot's own `eval_main` (one lerobot-eval run per
-cell); the demonstrators play the same episodes through the same env and episode log, as (cell, task, seed chunk)
-jobs over all workers (`expert_runs`). Each cell is written to a temporary directory and moved into place when
-complete, so a re-run skips finished cells (and, for the demonstrators, finished chunks). `wall_clock_s.txt` in a
-cell is the time from the start of the command to the cell's completion. The report (`tavis report`) is written at
-the end.
+as lerobot-eval uses them. Policy and demonstrators alike play (cell, task, seed chunk) jobs over all workers
+(`cell_runs`): a policy chunk is one run of LeRobot's own `eval_main`, so several share one GPU; the demonstrators
+play through the same env and episode log. Finished chunks survive a kill and each cell is moved into place when
+complete, so a re-run skips finished cells and chunks. `wall_clock_s.txt` in a cell is the time from the start of
+the command to the cell's completion. The report (`tavis report`) is written at the end.
 """
 
 from __future__ import annotations
 
 import json
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis import checks
-from lerobot_tavis.dataset_tools.staging import staged_directory
+from lerobot_tavis.dataset_tools.workers import BACKENDS
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.physics import POLICY_HZ
-from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
-from lerobot_tavis.eval.expert_runs import run_expert_cells
+from lerobot_tavis.eval.cell_runs import run_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
 START_SEED = 1000
@@ -50,10 +47,11 @@ class ProtocolConfig:
     policy_path: str | None = None  # None: the scripted demonstrators
     batch_size: int = 1
     device: str = "cpu"
-    workers: int = 1  # demonstrators: processes playing (cell, task, seed chunk) jobs
+    workers: int = 1  # (cell, task, seed chunk) jobs at once: local processes, or sharers of one GPU under Ray
     seed: int = START_SEED
-    chunk_episodes: int = 8  # demonstrators: consecutive seeds per job
+    chunk_episodes: int | None = None  # consecutive seeds per job; default 8 (demonstrators), 32 (policies)
     policy_options: tuple[tuple[str, object], ...] = ()  # (field, value) set on the checkpoint's policy config
+    backend: str = "local"  # or "ray" (dataset_tools.workers)
 
     def __post_init__(self):
         object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
@@ -61,9 +59,25 @@ class ProtocolConfig:
         checks.integer("batch_size", self.batch_size, 1)
         checks.integer("workers", self.workers, 1)
         checks.integer("seed", self.seed, 0)
-        checks.integer("chunk_episodes", self.chunk_episodes, 1)
+        if self.chunk_episodes is not None:
+            checks.integer("chunk_episodes", self.chunk_episodes, 1)
+        checks.choice("backend", self.backend, BACKENDS)
         checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, POLICY_HZ)
+
+
+    @property
+    def chunk_size(self) -> int:
+        """Episodes per job; for a policy a whole number of env batches."""
+        if self.policy_path is None:
+            return self.chunk_episodes or 8
+        wanted = self.chunk_episodes or 32
+        return self.batch_size * -(-wanted // self.batch_size)
+
+    @property
+    def gpus_per_job(self) -> float:
+        """The share of a GPU a Ray job asks for: `workers` policy jobs share each GPU."""
+        return 1.0 / self.workers if self.policy_path is not None and self.device.startswith("cuda") else 0.0
 
 
 def checkpoint_env(policy_path: str | Path) -> dict:
@@ -93,37 +107,17 @@ def run_protocol(cfg: ProtocolConfig) -> list[Path]:
             print(f"{cell.name}: done already, skipped")
         else:
             pending.append(cell)
-    start = time.perf_counter()
-    if cfg.policy_path is None:
-        run_expert_cells(cfg, pending)
-        return write_report(cfg.out_dir)
-    for cell in pending:
-        with staged_directory(cfg.out_dir / cell.name, overwrite=True) as partial:  # an unfinished cell is replaced
-            partial.mkdir()
-            _run_policy_cell(cfg, cell, partial)
-            (partial / "wall_clock_s.txt").write_text(f"{time.perf_counter() - start:.1f}\n")
-        print(f"{cell.name}: {time.perf_counter() - start:.0f} s")
+    if cfg.policy_path is not None:
+        _check_policy_options(cfg)
+    run_cells(cfg, pending)
     return write_report(cfg.out_dir)
 
 
-def _run_policy_cell(cfg: ProtocolConfig, cell: Cell, out: Path) -> None:
-    from lerobot.configs.default import EvalConfig
-    from lerobot.configs.eval import EvalPipelineConfig
+def _check_policy_options(cfg: ProtocolConfig) -> None:
+    """Refuse a `--policy-option` field the checkpoint's policy does not have, before any job starts."""
     from lerobot.configs.policies import PreTrainedConfig
-    from lerobot.scripts.lerobot_eval import eval_main
-
-    from lerobot_tavis.envs.config import TavisEnvConfig
 
     policy = PreTrainedConfig.from_pretrained(cfg.policy_path)
-    policy.pretrained_path = Path(cfg.policy_path)
-    policy.device = cfg.device
-    for name, value in cfg.policy_options:  # e.g. num_inference_steps=10, use_amp=true
+    for name, _ in cfg.policy_options:
         if not hasattr(policy, name):
             raise ValueError(f"--policy-option {name}: the {policy.type} policy has no such field")
-        setattr(policy, name, value)
-    env = TavisEnvConfig(task=cell.suite, robot=cfg.robot, camera_mode=cfg.camera_mode, split=cell.split,
-                         image_size=cfg.image_size, episode_length_s=cfg.episode_length_s,
-                         episode_log=str(out / EPISODE_LOG_NAME))
-    eval_main(EvalPipelineConfig(env=env, eval=EvalConfig(n_episodes=cfg.n_episodes, batch_size=cfg.batch_size,
-                                                          use_async_envs=cfg.batch_size > 1),
-                                 policy=policy, output_dir=out, seed=cfg.seed))

@@ -55,7 +55,8 @@ def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     stored = {"robot": "gr1t2", "suite": "tavis_hands", "task": "peeking_box", "task_id": 0, "split": "id",
               "camera_mode": "head_wrist", "seed": 1000, "success": False, "length_steps": 400, "prompt": "stored"}
     (work / "00_peeking_box_0001000.jsonl").write_text(json.dumps(stored) + "\n")
-    (work / "00_peeking_box_0001000.done.json").write_text(json.dumps({"successes": [False]}))
+    (work / "00_peeking_box_0001000.done.json").write_text(json.dumps(
+        {"successes": [False], "sum_rewards": [0.0], "max_rewards": [0.0]}))
     (work / "01_occluded_reach_0001000.jsonl").write_text("half a line of a killed chunk")  # no done record
     run_protocol(cfg)
     log, info = _cell_files(tmp_path)
@@ -138,6 +139,22 @@ def test_policy_protocol_runs_through_lerobot_eval(tmp_path):
     assert [(c["task"], c["split"], c["n"]) for c in results["cells"]] == [
         (task, "ood_init_pose", 1) for task in ("conditional_pick", "wait_then_act", "clutter_pick_cube",
                                                  "clutter_pick_lift", "multi_shelf_scan")]
+
+
+def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first_videos(tmp_path):
+    """Each chunk is one lerobot-eval run seeded with its first seed: two workers give the cell of one."""
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    common = dict(suites=("tavis_head",), splits=("id",), n_episodes=2, image_size=(32, 48), episode_length_s=0.5,
+                  policy_path=str(tmp_path / "ckpt"), policy_options=(("num_inference_steps", 1),), chunk_episodes=1)
+    run_protocol(ProtocolConfig(out_dir=tmp_path / "one", workers=1, **common))
+    run_protocol(ProtocolConfig(out_dir=tmp_path / "two", workers=2, **common))
+    one, two = _cell_files(tmp_path / "one", "tavis_head__id"), _cell_files(tmp_path / "two", "tavis_head__id")
+    assert one == two
+    records = [json.loads(line) for line in one[0].splitlines()]
+    assert [(r["task_id"], r["seed"]) for r in records] == [(t, s) for t in range(5) for s in (1000, 1001)]
+    videos = one[1]["per_task"][0]["metrics"]["video_paths"]
+    assert videos == ["videos/tavis_head_0/eval_episode_0.mp4"]  # from the chunk of seed 1000 only
+    assert (tmp_path / "one" / "tavis_head__id" / videos[0]).stat().st_size > 0
 
 
 def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path):

@@ -1,0 +1,220 @@
+"""Protocol cells as (cell, task, seed chunk) jobs spread over every worker, for the demonstrators and policies.
+
+All chunks of all pending cells go to one pool (`dataset_tools.workers`: local processes or Ray), so every core,
+or every share of a GPU, stays busy whatever the number of tasks. A chunk's outcome depends only on its task,
+split and seeds (a policy chunk is one lerobot-eval run seeded with its first seed), each chunk's results come back
+to this process, and each cell is assembled in a fixed order (task, then seed) once its last chunk is done: the
+results do not depend on the backend, the number of workers or the finishing order. Finished chunks are kept in the
+hidden folder `.<cell>.chunks/` (episode log and a `done` record), so a killed run resumes at chunk granularity;
+`tavis report` never reads hidden folders.
+
+- Demonstrators render nothing: they act on the simulator state, so pixels cannot change an outcome (the camera
+  mode still fixes whether the neck moves).
+- Policies run through LeRobot's own `eval_main`, each chunk in a scratch folder; the first chunk of each task
+  keeps lerobot-eval's videos (up to 10 episodes), as one lerobot-eval run of the cell would.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+import time
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import as_completed
+from dataclasses import dataclass
+from pathlib import Path
+
+from tqdm import tqdm
+
+from lerobot_tavis.dataset_tools.staging import staged_directory
+from lerobot_tavis.dataset_tools.workers import executor
+from lerobot_tavis.envs.tasks.catalog import expand_tasks
+from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
+from lerobot_tavis.eval.report import EVAL_INFO_NAME
+
+METRICS = ("successes", "sum_rewards", "max_rewards")  # per-episode lists of lerobot-eval's per-task metrics
+
+
+@dataclass(frozen=True)
+class Chunk:
+    """Episodes `first_seed .. first_seed + n - 1` of one task of one cell."""
+
+    cell_name: str
+    suite: str
+    split: str
+    task_id: int
+    task: str
+    first_seed: int
+    n: int
+
+    @property
+    def stem(self) -> str:
+        return f"{self.task_id:02d}_{self.task}_{self.first_seed:07d}"
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    chunk: Chunk
+    log_text: str  # the chunk's episode log lines
+    metrics: dict[str, list]  # METRICS, one value per episode
+    videos: dict[str, bytes]  # file name -> mp4, for the first chunk of a task
+
+
+def run_cells(cfg, cells: Sequence) -> None:
+    """Play every pending cell's episodes (policy `cfg.policy_path`, else the demonstrators) and write each cell
+    as lerobot-eval would."""
+    play = _play_expert_chunk if cfg.policy_path is None else _play_policy_chunk
+    chunks = {cell.name: _chunks(cfg, cell) for cell in cells}
+    work = {cell.name: cfg.out_dir / f".{cell.name}.chunks" for cell in cells}
+    waiting = {name: [c for c in cell_chunks if not _done_path(work[name], c).exists()]
+               for name, cell_chunks in chunks.items()}
+    todo = [chunk for name in waiting for chunk in waiting[name]]
+    total = sum(chunk.n for cell_chunks in chunks.values() for chunk in cell_chunks)
+    started = time.perf_counter()
+    desc = "demonstrators" if cfg.policy_path is None else "policy"
+    with tqdm(total=total, initial=total - sum(c.n for c in todo), desc=desc, unit="ep") as bar:
+        for name in [name for name, left in waiting.items() if not left]:  # finished before a kill
+            _assemble(cfg, name, chunks[name], work[name], started)
+        for result in _completed(cfg, play, [(cfg, chunk) for chunk in todo]):
+            chunk = result.chunk
+            _keep_chunk(work[chunk.cell_name], result)
+            bar.update(chunk.n)
+            waiting[chunk.cell_name].remove(chunk)
+            if not waiting[chunk.cell_name]:
+                _assemble(cfg, chunk.cell_name, chunks[chunk.cell_name], work[chunk.cell_name], started)
+
+
+def _chunks(cfg, cell) -> list[Chunk]:
+    tasks = expand_tasks(cell.suite)[cell.suite]
+    last = cfg.seed + cfg.n_episodes
+    size = cfg.chunk_size
+    return [Chunk(cell.name, cell.suite, cell.split, task_id, task, first, min(size, last - first))
+            for task_id, task in enumerate(tasks) for first in range(cfg.seed, last, size)]
+
+
+def _completed(cfg, fn: Callable, jobs: list[tuple]) -> Iterator:
+    """fn(*job) for every job, yielded as each finishes (in order with one local worker)."""
+    if cfg.workers == 1 and cfg.backend == "local":
+        try:
+            for job in jobs:
+                yield fn(*job)
+        finally:
+            _close_envs()
+        return
+    with executor(cfg.workers, cfg.backend, gpus_per_job=cfg.gpus_per_job) as pool:
+        futures = [pool.submit(fn, *job) for job in jobs]
+        try:
+            for future in as_completed(futures):
+                yield future.result()
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+_ENVS: dict[tuple, object] = {}  # per process: (task, split) -> its TavisEnv, reused across chunks
+
+
+def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
+    """Play one chunk with the demonstrators (in a worker)."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    from lerobot_tavis.envs.factory import make_tavis_env
+    from lerobot_tavis.eval.episode_log import EpisodeLogger
+    from lerobot_tavis.experts.registry import run_episode
+
+    key = (chunk.task, chunk.split)
+    if key not in _ENVS:
+        _ENVS[key] = make_tavis_env(chunk.task, cfg.robot, cfg.camera_mode, chunk.split, cfg.image_size,
+                                    cfg.episode_length_s, cameras=())  # the demonstrators read the state
+    with tempfile.TemporaryDirectory(prefix="tavis-chunk-") as scratch:
+        log_path = Path(scratch) / EPISODE_LOG_NAME
+        env = EpisodeLogger(_ENVS[key], log_path, suite=chunk.suite, task_id=chunk.task_id)
+        successes = [run_episode(env, seed).success for seed in range(chunk.first_seed, chunk.first_seed + chunk.n)]
+        rewards = [float(s) for s in successes]
+        return ChunkResult(chunk, log_path.read_text(),
+                           {"successes": successes, "sum_rewards": rewards, "max_rewards": rewards}, {})
+
+
+def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
+    """Play one chunk with the policy: one lerobot-eval run of its task and seeds, in a scratch folder (in a
+    worker)."""
+    from lerobot.configs.default import EvalConfig
+    from lerobot.configs.eval import EvalPipelineConfig
+    from lerobot.configs.policies import PreTrainedConfig
+    from lerobot.scripts.lerobot_eval import eval_main
+
+    from lerobot_tavis.envs.config import TavisEnvConfig
+
+    policy = PreTrainedConfig.from_pretrained(cfg.policy_path)
+    policy.pretrained_path = Path(cfg.policy_path)
+    policy.device = cfg.device
+    for name, value in cfg.policy_options:  # checked against the policy's fields by ProtocolConfig
+        setattr(policy, name, value)
+    batch = min(cfg.batch_size, chunk.n)
+    with tempfile.TemporaryDirectory(prefix="tavis-chunk-") as scratch:
+        out = Path(scratch) / "eval"
+        env = TavisEnvConfig(task=chunk.task, robot=cfg.robot, camera_mode=cfg.camera_mode, split=chunk.split,
+                             image_size=cfg.image_size, episode_length_s=cfg.episode_length_s,
+                             episode_log=str(out / EPISODE_LOG_NAME))
+        eval_main(EvalPipelineConfig(env=env, eval=EvalConfig(n_episodes=chunk.n, batch_size=batch,
+                                                              use_async_envs=batch > 1),
+                                     policy=policy, output_dir=out, seed=chunk.first_seed))
+        task_metrics = json.loads((out / EVAL_INFO_NAME).read_text())["per_task"][0]["metrics"]
+        lines = [json.loads(line) | {"task_id": chunk.task_id}  # the run saw a one-task suite
+                 for line in (out / EPISODE_LOG_NAME).read_text().splitlines()]
+        videos = ({path.name: path.read_bytes() for path in sorted((out / "videos").rglob("*.mp4"))}
+                  if chunk.first_seed == cfg.seed else {})
+        return ChunkResult(chunk, "".join(json.dumps(line) + "\n" for line in lines),
+                           {key: task_metrics[key] for key in METRICS}, videos)
+
+
+def _close_envs() -> None:
+    while _ENVS:
+        _ENVS.popitem()[1].close()
+
+
+def _done_path(work: Path, chunk: Chunk) -> Path:
+    return work / f"{chunk.stem}.done.json"
+
+
+def _keep_chunk(work: Path, result: ChunkResult) -> None:
+    """Write a finished chunk's episode log and videos, then its `done` record (the proof it is complete)."""
+    chunk = result.chunk
+    work.mkdir(parents=True, exist_ok=True)
+    (work / f"{chunk.stem}.jsonl").write_text(result.log_text)
+    for name, data in result.videos.items():
+        video = work / f"{chunk.stem}.videos" / name
+        video.parent.mkdir(exist_ok=True)
+        video.write_bytes(data)
+    partial = work / f".{chunk.stem}.done.partial"
+    partial.write_text(json.dumps(result.metrics))
+    os.replace(partial, _done_path(work, chunk))
+
+
+def _assemble(cfg, cell_name: str, chunks: list[Chunk], work: Path, started: float) -> None:
+    """Write the cell from its chunks, in task then seed order, and drop the chunks."""
+    suite = chunks[0].suite
+    per_task: dict[int, dict[str, list]] = {}
+    with staged_directory(cfg.out_dir / cell_name, overwrite=True) as partial:
+        partial.mkdir()
+        with open(partial / EPISODE_LOG_NAME, "w") as log:
+            for chunk in sorted(chunks, key=lambda c: (c.task_id, c.first_seed)):
+                log.write((work / f"{chunk.stem}.jsonl").read_text())
+                metrics = json.loads(_done_path(work, chunk).read_text())
+                task = per_task.setdefault(chunk.task_id, {key: [] for key in METRICS})
+                for key in METRICS:
+                    task[key].extend(metrics[key])
+                videos = work / f"{chunk.stem}.videos"
+                if videos.is_dir():
+                    shutil.copytree(videos, partial / "videos" / f"{suite}_{chunk.task_id}")
+        tasks = [{"task_group": suite, "task_id": task_id,
+                  "metrics": {**metrics, "video_paths": sorted(
+                      str(p.relative_to(partial)) for p in (partial / "videos" / f"{suite}_{task_id}").glob("*.mp4"))}}
+                 for task_id, metrics in sorted(per_task.items())]
+        flat = [s for metrics in per_task.values() for s in metrics["successes"]]
+        summary = {"pc_success": 100.0 * sum(flat) / len(flat), "n_episodes": len(flat)}
+        policy = "scripted demonstrators" if cfg.policy_path is None else str(cfg.policy_path)
+        info = {"per_task": tasks, "per_group": {suite: summary}, "overall": summary, "policy": policy}
+        (partial / EVAL_INFO_NAME).write_text(json.dumps(info, indent=2) + "\n")
+        (partial / "wall_clock_s.txt").write_text(f"{time.perf_counter() - started:.1f}\n")
+    shutil.rmtree(work)
