@@ -15,7 +15,7 @@
 #   libraries can be found (PyAV's bundled copy, tools/pyav_ffmpeg.sh), else with PyAV.
 # - eval: lerobot-eval on every complete checkpoint not yet evaluated (seeds from 1000), then `tavis report`; it
 #   can run beside `train`, which marks a checkpoint complete by pointing `checkpoints/last` at it.
-# - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for 1500 steps and
+# - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (5000) and
 #   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
 #   on points at a data or alignment bug, not at too little training.
 set -euo pipefail
@@ -92,8 +92,9 @@ if seeds != list(range(100_000, 100_008)):
     sys.exit(f"overfit: the evaluation assumes training seeds 100000-100007, the recording kept {seeds}")
 PY
     convert "$WORK/overfit/raw" "$WORK/overfit/dataset_$CONDITION"
-    time train "$WORK/overfit/dataset_$CONDITION" "$WORK/overfit/train_$CONDITION" --steps=1500 --save_freq=1500 \
-      --batch_size=32
+    steps=${OVERFIT_STEPS:-5000}
+    time train "$WORK/overfit/dataset_$CONDITION" "$WORK/overfit/train_$CONDITION" --steps="$steps" \
+      --save_freq="$steps" --batch_size=32
     evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/train_seeds" 100000 8
     evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/new_seeds" 1000 8
     ;;

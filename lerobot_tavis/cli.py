@@ -224,7 +224,8 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--workers", type=int, default=1,
                           help="(cell, task, seed chunk) jobs at once; with a policy on a GPU they share it")
     evaluate.add_argument("--chunk-episodes", type=int,
-                          help="consecutive episodes per job (default 8 for the demonstrators, 32 for a policy)")
+                          help="consecutive episodes per job, also what a killed run loses at most (default 8 for the "
+                          "demonstrators, 96 for a policy: each policy job starts a lerobot-eval run)")
     evaluate.add_argument("--backend", default="local", choices=BACKENDS,
                           help="local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)")
     evaluate.add_argument("--seed", type=int, default=1000, help="first episode seed (lerobot-eval's default)")

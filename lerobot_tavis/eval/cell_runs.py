@@ -112,7 +112,7 @@ def _completed(cfg, fn: Callable, jobs: list[tuple]) -> Iterator:
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-_ENVS: dict[tuple, object] = {}  # per process: (task, split) -> its TavisEnv, reused across chunks
+_ENVS: dict[tuple, object] = {}  # per process: the last chunk's (task, split) -> its TavisEnv, for the next chunk
 
 
 def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
@@ -124,6 +124,7 @@ def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
 
     key = (chunk.task, chunk.split)
     if key not in _ENVS:
+        _close_envs()  # one compiled scene per worker: each holds about 70 MB
         _ENVS[key] = make_tavis_env(chunk.task, cfg.robot, cfg.camera_mode, chunk.split, cfg.image_size,
                                     cfg.episode_length_s, cameras=())  # the demonstrators read the state
     with tempfile.TemporaryDirectory(prefix="tavis-chunk-") as scratch:
@@ -138,6 +139,7 @@ def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
 def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
     """Play one chunk with the policy: one lerobot-eval run of its task and seeds, in a scratch folder (in a
     worker)."""
+    import lerobot.policies  # noqa: F401  (registers the policy types that from_pretrained looks up)
     from lerobot.configs.default import EvalConfig
     from lerobot.configs.eval import EvalPipelineConfig
     from lerobot.configs.policies import PreTrainedConfig

@@ -49,7 +49,7 @@ class ProtocolConfig:
     device: str = "cpu"
     workers: int = 1  # (cell, task, seed chunk) jobs at once: local processes, or sharers of one GPU under Ray
     seed: int = START_SEED
-    chunk_episodes: int | None = None  # consecutive seeds per job; default 8 (demonstrators), 32 (policies)
+    chunk_episodes: int | None = None  # consecutive seeds per job; default 8 (demonstrators), 96 (policies)
     policy_options: tuple[tuple[str, object], ...] = ()  # (field, value) set on the checkpoint's policy config
     backend: str = "local"  # or "ray" (dataset_tools.workers)
 
@@ -71,7 +71,7 @@ class ProtocolConfig:
         """Episodes per job; for a policy a whole number of env batches."""
         if self.policy_path is None:
             return self.chunk_episodes or 8
-        wanted = self.chunk_episodes or 32
+        wanted = self.chunk_episodes or 96  # a lerobot-eval run costs tens of seconds to start
         return self.batch_size * -(-wanted // self.batch_size)
 
     @property
@@ -115,6 +115,7 @@ def run_protocol(cfg: ProtocolConfig) -> list[Path]:
 
 def _check_policy_options(cfg: ProtocolConfig) -> None:
     """Refuse a `--policy-option` field the checkpoint's policy does not have, before any job starts."""
+    import lerobot.policies  # noqa: F401  (registers the policy types that from_pretrained looks up)
     from lerobot.configs.policies import PreTrainedConfig
 
     policy = PreTrainedConfig.from_pretrained(cfg.policy_path)
