@@ -108,6 +108,18 @@ def test_an_unknown_policy_option_names_the_field(tmp_path):
         run_protocol(cfg)
 
 
+def test_a_fresh_tavis_eval_process_reads_the_checkpoints_policy_type(tmp_path):
+    """In a new process nothing has imported LeRobot's policies yet: their types must be registered before the
+    checkpoint's config is read (else: "Policy type 'diffusion' ... is not registered")."""
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    tavis = os.path.join(os.path.dirname(sys.executable), "tavis")
+    done = subprocess.run([tavis, "eval", "--policy", str(tmp_path / "ckpt"), "--out", str(tmp_path / "eval"),
+                           "--policy-option", "denoise=3"], capture_output=True, text=True,
+                          env={**os.environ, "HF_HUB_OFFLINE": "1"})
+    assert done.returncode != 0
+    assert "--policy-option denoise: the diffusion policy has no such field" in done.stderr, done.stderr
+
+
 def test_a_missing_checkpoint_path_says_so(tmp_path):
     missing = tmp_path / "outputs" / "train" / "checkpoints" / "last" / "pretrained_model"
     with pytest.raises(SystemExit, match=f"--policy {missing}: no such checkpoint directory"):
