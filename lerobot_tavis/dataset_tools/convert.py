@@ -29,6 +29,7 @@ from tqdm import tqdm
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
+from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.dataset_tools.workers import executor
 from lerobot_tavis.envs.tasks.catalog import task_sort_key
@@ -67,6 +68,8 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     from lerobot_tavis.envs.robots import make_robot
+
+    quiet_media_libraries()
 
     cameras = ft.parse_cameras(cfg.cameras)
     manifest = Manifest.load(cfg.raw_dir)

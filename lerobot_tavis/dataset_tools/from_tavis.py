@@ -37,6 +37,7 @@ import numpy as np
 
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.dataset_tools import features as ft
+from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SPLITS
 
@@ -112,6 +113,7 @@ def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, 
         if not episodes:
             raise ValueError(f"{source_root} has no episode of task {task!r}")
 
+    quiet_media_libraries()
     with staged_directory(root, overwrite=overwrite) as staging:
         dataset = LeRobotDataset.create(repo_id, fps=fps, root=staging, robot_type=robot, use_videos=True,
                                         features=ft.dataset_features(joint_names, cameras.values(), size))

@@ -1,6 +1,7 @@
 """`tavis record` and `tavis convert`: raw episodes that replay exactly, and the LeRobotDataset made from them."""
 
 import json
+import os
 import subprocess
 import sys
 
@@ -119,6 +120,18 @@ def test_frames_pair_each_observation_with_the_last_command_of_its_interval(data
     assert float(dataset[blocked_start][image_key("head")].max()) < 0.05  # the head camera is black there
     log = json.loads((dataset.root / "meta" / "tavis_conversion.json").read_text())
     assert [e["max_qpos_deviation"] for e in log["episodes"]] == [0.0] * 6  # exact replay
+
+
+def test_convert_prints_its_progress_and_no_encoder_chatter(raw_dir, tmp_path):
+    """No SVT-AV1 banner, FFmpeg muxer line, per-episode `datasets` bar or traceback: only tavis's own output."""
+    tavis = os.path.join(os.path.dirname(sys.executable), "tavis")
+    done = subprocess.run([tavis, "convert", str(raw_dir), "--repo-id", "local/quiet", "--root", str(tmp_path / "ds"),
+                           "--image-size", "24x32", "--cameras", "head", "--task", "occluded_reach"],
+                          capture_output=True, text=True, timeout=300, check=True)
+    output = done.stdout + done.stderr
+    for chatter in ("Svt[", "[mp4 @", "Map:", "Traceback", "moov atom"):
+        assert chatter not in output, f"{chatter!r} in:\n{output}"
+    assert "convert local/quiet" in output and str(tmp_path / "ds") in output
 
 
 def test_converting_twice_gives_identical_data_whatever_the_workers(raw_dir, tmp_path):
