@@ -138,8 +138,10 @@ def pull_dataset(repo_id: str, root: str | Path | None = None, revision: str | N
     checks.repo_id(repo_id)
     from lerobot.datasets import LeRobotDataset
 
+    from lerobot_tavis.dataset_tools.quiet import video_backend
+
     with _hub_errors(repo_id):
-        return LeRobotDataset(repo_id, root=root, revision=revision)
+        return LeRobotDataset(repo_id, root=root, revision=revision, video_backend=video_backend())
 
 
 def _check_dataset_root(root: str | Path) -> Path:

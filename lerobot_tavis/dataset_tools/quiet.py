@@ -37,3 +37,13 @@ def _set_ffmpeg_level(level: int) -> None:
         if Path(path).name.startswith("libavutil"):
             ctypes.CDLL(path).av_log_set_level(level)
             return
+
+
+def video_backend() -> str:
+    """torchcodec where it can load (it needs FFmpeg's shared libraries), else PyAV, chosen without the long
+    traceback LeRobot shows when it picks torchcodec on a machine without those libraries."""
+    try:
+        import torchcodec.decoders  # noqa: F401
+    except Exception:  # torchcodec raises RuntimeError (and others) listing every FFmpeg it tried
+        return "pyav"
+    return "torchcodec"
