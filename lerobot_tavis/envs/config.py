@@ -31,16 +31,35 @@ ROBOT_NAMES = ("gr1t2", "reachy2")
 @EnvConfig.register_subclass("tavis")
 @dataclass
 class TavisEnvConfig(EnvConfig):
+    """The TAVIS benchmark in MuJoCo (lerobot_tavis): egocentric active vision tasks on a humanoid torso."""
+
+    # Suite (tavis_head, tavis_hands), task (conditional_pick, wait_then_act, clutter_pick_cube, clutter_pick_lift,
+    # multi_shelf_scan, peeking_box, occluded_reach, blocked_clutter_pick_cube) or a comma list of them
     task: str = "tavis_head"
+    # Policy steps per second; fixed by the benchmark at 20
     fps: int = 20
+    # Robot: gr1t2 or reachy2
     robot: str = "gr1t2"
-    camera_mode: str = DEFAULT_CAMERA_MODE  # the paper's "headcam" condition: head and both wrist cameras
+    # Cameras the policy sees: head_wrist (the paper's "headcam": head and both wrists), fixed_wrist (its
+    # "fixedcam": fixed workspace camera and both wrists), head_only, fixed_only
+    camera_mode: str = DEFAULT_CAMERA_MODE
+    # Episode distribution: id, ood_spatial (wider zones, closer objects) or ood_init_pose (the id scene from a
+    # perturbed hand and head start)
     split: str = "id"
+    # Camera images as height width, pixels (16-4096 each); the cameras' native size is 480 640
     image_size: tuple[int, int] = (480, 640)
+    # Episode length in seconds (400 steps at 20 Hz by default)
     episode_length_s: float = 20.0
-    episode_log: str | None = None  # JSON-lines file; default: <output_dir>/episodes.jsonl of lerobot-eval/-train
+    # JSON-lines log of every finished episode (seed, success, GALT); default <output_dir>/episodes.jsonl
+    episode_log: str | None = None
+    # Derived from camera_mode and image_size; not to be set
     features: dict[str, PolicyFeature] = field(default_factory=dict)
+    # Derived from camera_mode; not to be set
     features_map: dict[str, str] = field(default_factory=dict)
+    # Tasks of a suite that lerobot-eval runs at once (threads)
+    max_parallel_tasks: int = 1
+    # Skip gymnasium's env checker
+    disable_env_checker: bool = True
 
     def __post_init__(self):
         expand_tasks(self.task)  # raises a clear error for an unknown task or suite
