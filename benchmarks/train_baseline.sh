@@ -37,7 +37,7 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 
 choose_video_backend() {  # BACKEND=torchcodec when it loads (with PyAV's FFmpeg if the system has none), else pyav
   eval "$("$HERE/../tools/pyav_ffmpeg.sh" "$WORK/ffmpeg")"  # exports LD_LIBRARY_PATH for lerobot-train
-  if python3 -c "import torchcodec.decoders" 2>/dev/null; then BACKEND=torchcodec; else BACKEND=pyav; fi
+  BACKEND=$(python3 -c "from lerobot_tavis.dataset_tools.quiet import video_backend; print(video_backend())")
 }
 
 convert() {  # convert RAW_DIR DATASET_DIR

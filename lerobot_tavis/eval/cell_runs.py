@@ -136,22 +136,32 @@ def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
                            {"successes": successes, "sum_rewards": rewards, "max_rewards": rewards}, {})
 
 
-def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
-    """Play one chunk with the policy: one lerobot-eval run of its task and seeds, in a scratch folder (in a
-    worker)."""
+def policy_config(cfg):
+    """The checkpoint's policy config with the run's device and `--policy-option` fields set; an option the policy
+    does not have is refused, naming it."""
     import lerobot.policies  # noqa: F401  (registers the policy types that from_pretrained looks up)
-    from lerobot.configs.default import EvalConfig
-    from lerobot.configs.eval import EvalPipelineConfig
     from lerobot.configs.policies import PreTrainedConfig
-    from lerobot.scripts.lerobot_eval import eval_main
-
-    from lerobot_tavis.envs.config import TavisEnvConfig
 
     policy = PreTrainedConfig.from_pretrained(cfg.policy_path)
     policy.pretrained_path = Path(cfg.policy_path)
     policy.device = cfg.device
-    for name, value in cfg.policy_options:  # checked against the policy's fields by ProtocolConfig
+    for name, value in cfg.policy_options:  # e.g. num_inference_steps=10, use_amp=true
+        if not hasattr(policy, name):
+            raise ValueError(f"--policy-option {name}: the {policy.type} policy has no such field")
         setattr(policy, name, value)
+    return policy
+
+
+def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
+    """Play one chunk with the policy: one lerobot-eval run of its task and seeds, in a scratch folder (in a
+    worker)."""
+    from lerobot.configs.default import EvalConfig
+    from lerobot.configs.eval import EvalPipelineConfig
+    from lerobot.scripts.lerobot_eval import eval_main
+
+    from lerobot_tavis.envs.config import TavisEnvConfig
+
+    policy = policy_config(cfg)
     batch = min(cfg.batch_size, chunk.n)
     with tempfile.TemporaryDirectory(prefix="tavis-chunk-") as scratch:
         out = Path(scratch) / "eval"

@@ -18,7 +18,7 @@ from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.workers import BACKENDS
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.physics import POLICY_HZ
-from lerobot_tavis.eval.cell_runs import run_cells
+from lerobot_tavis.eval.cell_runs import policy_config, run_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
 START_SEED = 1000
@@ -65,7 +65,6 @@ class ProtocolConfig:
         checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, POLICY_HZ)
 
-
     @property
     def chunk_size(self) -> int:
         """Episodes per job; for a policy a whole number of env batches."""
@@ -108,17 +107,6 @@ def run_protocol(cfg: ProtocolConfig) -> list[Path]:
         else:
             pending.append(cell)
     if cfg.policy_path is not None:
-        _check_policy_options(cfg)
+        policy_config(cfg)  # a bad --policy-option fails here, before any job starts
     run_cells(cfg, pending)
     return write_report(cfg.out_dir)
-
-
-def _check_policy_options(cfg: ProtocolConfig) -> None:
-    """Refuse a `--policy-option` field the checkpoint's policy does not have, before any job starts."""
-    import lerobot.policies  # noqa: F401  (registers the policy types that from_pretrained looks up)
-    from lerobot.configs.policies import PreTrainedConfig
-
-    policy = PreTrainedConfig.from_pretrained(cfg.policy_path)
-    for name, _ in cfg.policy_options:
-        if not hasattr(policy, name):
-            raise ValueError(f"--policy-option {name}: the {policy.type} policy has no such field")
