@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact Diffusion Policy -> evaluation
+# One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact ACT policy -> evaluation
 # of every checkpoint (96 episodes each, Wilson intervals and GALT by `tavis report`).
 #
 #   benchmarks/train_baseline.sh data|train|eval|overfit
@@ -11,11 +11,11 @@
 #
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
-# - train: lerobot-train with the `diffusion_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
+# - train: lerobot-train with the `act_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
 #   libraries can be found (PyAV's bundled copy, tools/pyav_ffmpeg.sh), else with PyAV.
 # - eval: lerobot-eval on every complete checkpoint not yet evaluated (seeds from 1000), then `tavis report`; it
 #   can run beside `train`, which marks a checkpoint complete by pointing `checkpoints/last` at it.
-# - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (5000) and
+# - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (3000) and
 #   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
 #   on points at a data or alignment bug, not at too little training.
 set -euo pipefail
@@ -48,7 +48,7 @@ convert() {  # convert RAW_DIR DATASET_DIR
 train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]
   local dataset=$1 out=$2
   shift 2
-  lerobot-train --config_path="$(tavis presets "diffusion_${CONDITION}_compact")" \
+  lerobot-train --config_path="$(tavis presets "act_${CONDITION}_compact")" \
     --dataset.repo_id="local/$(basename "$dataset")" --dataset.root="$dataset" --dataset.video_backend="$BACKEND" \
     --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true --num_workers="$WORKERS" \
     --log_freq=100 --output_dir="$out" "$@"
@@ -92,7 +92,7 @@ if seeds != list(range(100_000, 100_008)):
     sys.exit(f"overfit: the evaluation assumes training seeds 100000-100007, the recording kept {seeds}")
 PY
     convert "$WORK/overfit/raw" "$WORK/overfit/dataset_$CONDITION"
-    steps=${OVERFIT_STEPS:-5000}
+    steps=${OVERFIT_STEPS:-3000}
     time train "$WORK/overfit/dataset_$CONDITION" "$WORK/overfit/train_$CONDITION" --steps="$steps" \
       --save_freq="$steps" --batch_size=32
     evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/train_seeds" 100000 8

@@ -47,7 +47,9 @@ def test_the_shipped_files_are_the_generated_presets():
     with pytest.raises(ValueError, match="unknown preset"):
         preset_path("act_headcam")
     with pytest.raises(ValueError, match="compact presets exist for"):
-        build_preset("diffusion", "head_only", compact=True)
+        build_preset("act", "head_only", compact=True)
+    with pytest.raises(ValueError, match="compact presets are ACT presets"):
+        build_preset("diffusion", "head_wrist", compact=True)
 
 
 @pytest.mark.parametrize("name", preset_names())
@@ -58,7 +60,7 @@ def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_r
     cfg = _parse(name, "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}")
     policy, mode, compact = presets()[name]
     assert cfg.policy.type == policy and cfg.env.type == "tavis" and cfg.env.camera_mode == mode
-    assert (cfg.policy.n_action_steps, cfg.batch_size) == (8, 64 if compact else 16)
+    assert (cfg.policy.n_action_steps, cfg.batch_size) == ((10, 64) if compact else (8, 16))
     dataset_features = dataset_to_policy_features(LeRobotDatasetMetadata("local/tiny", root=dataset_root).features)
     env_keys = set(cfg.env.features_map.values())
     for key, feature in cfg.policy.input_features.items():
@@ -69,11 +71,13 @@ def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_r
         {"left_wrist", "right_wrist"} if mode.endswith("wrist") else set())
     if policy == "diffusion":
         assert (cfg.policy.n_obs_steps, cfg.policy.horizon, cfg.policy.optimizer_lr) == (2, 16, 1e-4)
-        size = (120, 160) if compact else (240, 320)
-        assert tuple(cfg.policy.resize_shape) == size == tuple(cfg.env.image_size)
-        assert cfg.policy.pretrained_backbone_weights is None
-        assert cfg.policy.use_group_norm is not compact and cfg.policy.noise_scheduler_type == (
-            "DDIM" if compact else "DDPM")
+        assert tuple(cfg.policy.resize_shape) == (240, 320) == tuple(cfg.env.image_size)
+        assert cfg.policy.pretrained_backbone_weights is None and cfg.policy.use_group_norm
+        assert cfg.policy.noise_scheduler_type == "DDPM"
+    elif policy == "act":
+        assert (cfg.policy.chunk_size, cfg.policy.optimizer_lr, cfg.policy.optimizer_lr_backbone) == (20, 1e-4, 1e-4)
+        assert cfg.policy.pretrained_backbone_weights is None and tuple(cfg.env.image_size) == (120, 160)
+        assert all(f.shape[1:] == (120, 160) for k, f in cfg.policy.input_features.items() if "images" in k)
     else:
         assert (cfg.policy.chunk_size, cfg.policy.optimizer_lr) == (16, 2.5e-5)
         assert str(cfg.policy.pretrained_path) == "lerobot/pi0_base"
