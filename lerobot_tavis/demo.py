@@ -1,7 +1,8 @@
 """`tavis demo`: one scripted-demonstrator episode of every task on each robot, filmed by all four cameras.
 
-Writes `<out>/<robot>/<task>.mp4` with the head, fixed and wrist views side by side (the head view is black in
-blocked_clutter_pick_cube, as the policy sees it) and prints whether each episode succeeded.
+Writes `<out>/<robot>/<task>.mp4`: the overview camera beside the head, fixed and wrist views (the head view is
+black in blocked_clutter_pick_cube, as the policy sees it), with the prompt, the clock, success and the gaze and
+hand events GALT finds in the episode (`lerobot_tavis.overlay`), and prints whether each episode succeeded.
 """
 
 from __future__ import annotations
@@ -16,25 +17,32 @@ from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_NAMES
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 from lerobot_tavis.experts.registry import make_expert
-from lerobot_tavis.media import side_by_side, write_mp4
+from lerobot_tavis.media import write_mp4
+from lerobot_tavis.metrics.galt import compute_galt
+from lerobot_tavis.overlay import Caption, EpisodeEvents, redraw_caption
 
 FPS = 20
 TASKS = BENCHMARK_TASKS
 
 
 def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) -> tuple[list[np.ndarray], bool]:
-    """Frames (four labelled views side by side) of one demonstrator episode, and whether it succeeded."""
+    """Annotated frames of one demonstrator episode, and whether it succeeded."""
     env = TavisEnv(task, robot, camera_mode="head_wrist", image_size=image_size, cameras=CAMERA_NAMES)
-    obs, _ = env.reset(seed=seed)
+    env.reset(seed=seed)
     expert = make_expert(env, seed)
     expert.reset()
-    frames, success = [side_by_side(obs["pixels"])], False
+    frames, actions, success = [env.render()], [], False
     for _ in range(env._max_episode_steps):
-        obs, _, terminated, truncated, info = env.step(expert.act())
-        frames.append(side_by_side(obs["pixels"]))
+        _, _, terminated, truncated, info = env.step(expert.act())
+        frames.append(env.render())
+        actions.append(info["applied_action"])
         success = info["is_success"]
         if terminated or truncated:
             break
+    duration_s = len(actions) / env.fps
+    events = EpisodeEvents.from_galt(compute_galt(np.array(actions), fps=env.fps), duration_s if success else None)
+    frames = [redraw_caption(frame, Caption(env.task_description, step / env.fps, duration_s, events))
+              for step, frame in enumerate(frames)]
     frames += frames[-1:] * FPS  # one more second on the final frame
     env.close()
     return frames, success

@@ -5,13 +5,13 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import av
 import cv2
 import numpy as np
 
 
 def write_mp4(path: str | Path, frames: list[np.ndarray], fps: int) -> Path:
     """Encode RGB uint8 frames (H, W, 3; H and W even) as H.264 MP4."""
+    import av  # PyAV: only where videos are written
     path = Path(path)
     if not frames:
         raise ValueError(f"no frames to write to {path}")
@@ -48,7 +48,3 @@ def label(image: np.ndarray, text: str) -> np.ndarray:
     cv2.putText(out, text, (8, int(22 * scale)), cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), 1, cv2.LINE_AA)
     return out
 
-
-def side_by_side(frames: dict[str, np.ndarray]) -> np.ndarray:
-    """Labelled frames of equal height in one row."""
-    return np.concatenate([label(image, name) for name, image in frames.items()], axis=1)

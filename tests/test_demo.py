@@ -1,15 +1,22 @@
 import av
+import numpy as np
 
 from lerobot_tavis.demo import run_demo
+from lerobot_tavis.overlay import EVENT_COLOURS, MIN_PANEL_HEIGHT, band_height
 
 
-def test_demo_writes_a_side_by_side_video_per_task(tmp_path):
+def test_demo_writes_an_annotated_video_per_task(tmp_path):
     written = run_demo(tmp_path, robots=("gr1t2",), tasks=("wait_then_act", "blocked_clutter_pick_cube"),
                        image_size=(32, 48))
     assert [p.name for p in written] == ["wait_then_act.mp4", "blocked_clutter_pick_cube.mp4"]
     with av.open(str(tmp_path / "gr1t2" / "blocked_clutter_pick_cube.mp4")) as video:
         frames = [f.to_ndarray(format="rgb24") for f in video.decode(video=0)]
-    assert frames[0].shape == (32, 4 * 48, 3)  # head, fixed, left and right wrist views in one row
-    assert frames[-1][12:, :40].max() < 40  # the blocked head view stays dark (its label is above row 12)
+    scale = int(np.ceil(MIN_PANEL_HEIGHT / 32))
+    panel_h, panel_w = 32 * scale, 2 * 48 * scale  # the overview, then the four views at half size, two per row
+    assert frames[0].shape == (panel_h + band_height(panel_w), panel_w, 3)
+    head_cell = frames[-1][panel_h // 8:panel_h // 2, panel_w // 2:3 * panel_w // 4]  # below its label
+    assert head_cell.max() < 40  # the blocked head view stays dark
+    band = frames[-1][panel_h:]
+    assert np.any(np.all(np.abs(band.astype(int) - EVENT_COLOURS["success"]) < 30, axis=-1))  # SUCCESS shown
     assert len(frames) > 40
     assert not list(tmp_path.rglob("*.partial*"))

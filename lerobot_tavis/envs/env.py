@@ -17,8 +17,8 @@ import numpy as np
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.control import Controller
-from lerobot_tavis.envs.modes import (CAMERA_NAMES, DEFAULT_CAMERA_MODE, VIEW_CAMERAS, mode_cameras, neck_locked,
-                                      resolve_camera_mode)
+from lerobot_tavis.envs.modes import (CAMERA_NAMES, DEFAULT_CAMERA_MODE, OVERVIEW_CAMERA, VIEW_CAMERAS, mode_cameras,
+                                      neck_locked, resolve_camera_mode)
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
@@ -110,6 +110,7 @@ class TavisEnv(gym.Env):
         self._sim: _Sim | None = None
         self._steps = 0
         self._last_frames: dict[str, np.ndarray] | None = None
+        self._success_s: float | None = None  # when the task first reported success in this episode
 
         n_joints = len(self._robot.joint_names())
         self.observation_space = gym.spaces.Dict({
@@ -132,6 +133,7 @@ class TavisEnv(gym.Env):
         mujoco.mj_forward(sim.model, sim.data)
         self._settle(sim)
         self._steps = 0
+        self._success_s = None
         if self.split == "ood_init_pose":
             self._warm_up(sim)
         return self._observe(sim), {"is_success": False}
@@ -149,17 +151,28 @@ class TavisEnv(gym.Env):
             return self._observe(sim), 0.0, False, True, info
         self._task.after_step(sim.model, sim.data, self._steps / self.fps)
         success = bool(self._task.is_success(sim.data))
+        if success and self._success_s is None:
+            self._success_s = self._steps / self.fps
         truncated = self._steps >= self._max_episode_steps and not success
         info = {"is_success": success, "applied_action": applied}
         return self._observe(sim), float(success), success, truncated, info
 
     def render(self) -> np.ndarray:
-        """The last observation's camera images side by side, without rendering again."""
+        """A frame for people (the videos lerobot-eval writes): the third-person overview camera, rendered now,
+        beside the last observation's camera images, with the prompt, the clock and success drawn on
+        (`lerobot_tavis.overlay`). The overview is never part of an observation."""
         if self._last_frames is None:
             raise RuntimeError("render() needs an observation: call reset() first")
         if not self.camera_names:
             raise RuntimeError("this env renders no cameras (it was made with cameras=())")
-        return np.concatenate([self._last_frames[name] for name in self.camera_names], axis=1)
+        from lerobot_tavis import overlay  # OpenCV: only in a process that films
+
+        sim = self._require_sim()
+        overview = sim.rig.render_camera(sim.data, sim.world.cameras[OVERVIEW_CAMERA])
+        events = overlay.EpisodeEvents(success=self._success_s)
+        caption = overlay.Caption(self.task_description, self._steps / self.fps, self._max_episode_steps / self.fps,
+                                  events)
+        return overlay.compose(self._last_frames, overview, caption)
 
     def close(self) -> None:
         if self._sim is not None:

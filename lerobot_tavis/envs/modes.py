@@ -11,7 +11,8 @@ import warnings
 
 CAMERA_NAMES = ("head", "fixed", "left_wrist", "right_wrist")
 # Cameras for people (gallery, videos), never part of a camera mode's observation.
-VIEW_CAMERAS = ("overview",)
+OVERVIEW_CAMERA = "overview"
+VIEW_CAMERAS = (OVERVIEW_CAMERA,)
 
 CAMERA_MODES: dict[str, tuple[str, ...]] = {
     "head_wrist": ("head", "left_wrist", "right_wrist"),

@@ -17,6 +17,7 @@ import numpy as np
 
 from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.assets import add_material, add_texture
+from lerobot_tavis.envs.modes import OVERVIEW_CAMERA
 from lerobot_tavis.envs.transforms import camera_quat, vfov_deg
 
 TABLE_TOP_Z = 1.0
@@ -174,7 +175,6 @@ def add_fixed_camera(spec: mujoco.MjSpec) -> None:
 
 
 # Third-person view for people (gallery, videos), never observed by a policy: front-right, above the table edge.
-OVERVIEW_CAMERA = "overview"
 OVERVIEW_CAMERA_POS = (1.20, -0.90, 1.90)
 OVERVIEW_LOOK_AT = (0.15, 0.0, 1.15)
 

@@ -8,6 +8,7 @@ from gymnasium.utils.env_checker import check_env
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.env import TavisEnv
+from lerobot_tavis.overlay import Caption, compose
 from tests.conftest import run_steps
 
 
@@ -77,14 +78,20 @@ def test_what_lerobot_reads(small_env):
         assert truncated == (step == 9)
 
 
-def test_render_returns_the_last_frames_without_rendering_again(small_env, monkeypatch):
+def test_render_adds_the_overview_to_the_last_frames_without_rendering_them_again(small_env, monkeypatch):
     env = small_env(robot="gr1t2", camera_mode="head_wrist")
     obs, _ = env.reset(seed=0)
-    calls = []
-    monkeypatch.setattr(env._sim.rig, "render", lambda data: calls.append(1))
+    observed, overview = [], []
+    monkeypatch.setattr(env._sim.rig, "render", lambda data: observed.append(1))
+    original = env._sim.rig.render_camera
+    monkeypatch.setattr(env._sim.rig, "render_camera",
+                        lambda data, camera_id: overview.append(camera_id) or original(data, camera_id))
     frame = env.render()
-    assert not calls
-    np.testing.assert_array_equal(frame, np.concatenate([obs["pixels"][c] for c in env.camera_names], axis=1))
+    assert not observed and overview == [env.world.cameras["overview"]]
+    expected = compose(obs["pixels"], original(env.data, overview[0]),
+                       Caption(env.task_description, 0.0, env._max_episode_steps / env.fps))
+    np.testing.assert_array_equal(frame, expected)
+    assert "overview" not in obs["pixels"]
 
 
 def test_simulator_is_built_lazily_and_released_by_close():

@@ -1,0 +1,160 @@
+"""Annotated video frames for people: a third-person overview beside the policy's own views, and a caption band
+with the prompt, the clock, success and the gaze and hand events GALT found.
+
+    +-------------------+---------+---------+
+    |                   | head    | left    |     overview (h x w) | the policy's views, half size, 2 per row
+    |     overview      +---------+---------+
+    |                   | right   |         |
+    +-------------------+---------+---------+
+    | prompt                       t 3.25 s |     caption band: prompt, clock, SUCCESS once it happened
+    | |--gaze---reach----grasp--|--------->  |     timeline of the episode with its events and the cursor
+    +----------------------------------------+
+
+Live frames (the env's `render()`, which lerobot-eval films) know only what has happened so far: the clock and
+success. Once an episode is over its events are known (`EpisodeEvents`) and `redraw_caption` rewrites the band of
+frames already composed, so the same layout serves `tavis demo` and the videos `tavis report` annotates. Numpy and
+OpenCV only: no simulator here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from lerobot_tavis.media import label
+from lerobot_tavis.metrics.galt import GaltResult
+
+MIN_PANEL_HEIGHT = 360  # composed panels are scaled up to at least this many pixels, so the text stays legible
+BAND_HEIGHT_PER_WIDTH = 0.11  # the caption band's height, relative to the frame's width
+WHITE, GREY, GREEN, BLACK = (255, 255, 255), (150, 150, 150), (60, 200, 90), (20, 20, 20)
+EVENT_COLOURS = {"gaze": (80, 170, 255), "reach": (255, 170, 60), "grasp": (240, 80, 80), "success": GREEN}
+
+
+@dataclass(frozen=True)
+class EpisodeEvents:
+    """Times (s from the first observation) of what happened in one episode; None where nothing was found.
+    `gaze`: the head's arrival on its final fixation, `reach`: the grasping hand's onset, `grasp`: the final
+    gripper closing (GALT's anchor), `success`: the step the task first reported success."""
+
+    gaze: float | None = None
+    reach: float | None = None
+    grasp: float | None = None
+    success: float | None = None
+
+    @classmethod
+    def from_episode_record(cls, record: dict, fps: float) -> EpisodeEvents:
+        """The events of one line of the episode log (`lerobot_tavis.eval.episode_log`)."""
+        success = record["length_steps"] / fps if record.get("success") else None
+        return cls(gaze=record.get("galt_t_head_arrival_s"), reach=record.get("galt_t_hand_onset_s"),
+                   grasp=record.get("galt_t_hand_arrival_s"), success=success)
+
+    @classmethod
+    def from_galt(cls, result: GaltResult, success_s: float | None) -> EpisodeEvents:
+        """The events of a GALT result (`lerobot_tavis.metrics.galt.compute_galt`) and the success time."""
+        return cls(gaze=result.t_head_arrival_s, reach=result.t_hand_onset_s, grasp=result.t_hand_arrival_s,
+                   success=success_s)
+
+    def items(self) -> list[tuple[str, float]]:
+        return [(name, time) for name, time in vars(self).items() if time is not None]
+
+
+@dataclass(frozen=True)
+class Caption:
+    """What the band of one frame says: `time_s` of `duration_s` seconds, and the events known at that frame
+    (drawn on the timeline; SUCCESS shows once `time_s` reaches `events.success`)."""
+
+    prompt: str
+    time_s: float
+    duration_s: float
+    events: EpisodeEvents = EpisodeEvents()
+
+
+def compose(views: dict[str, np.ndarray], overview: np.ndarray, caption: Caption) -> np.ndarray:
+    """One annotated frame: the overview, the labelled policy views (each (h, w, 3) like the overview) and the
+    caption band; height and width even, as H.264 needs."""
+    scale = max(1, int(np.ceil(MIN_PANEL_HEIGHT / overview.shape[0])))
+    height, width = overview.shape[0] * scale, overview.shape[1] * scale
+    overview = cv2.resize(overview, (width, height), interpolation=cv2.INTER_LINEAR)
+    panel = np.concatenate([label(overview, "overview"), _view_grid(views, height, width)], axis=1)
+    panel = panel[: panel.shape[0] // 2 * 2, : panel.shape[1] // 2 * 2]
+    band = np.zeros((band_height(panel.shape[1]), panel.shape[1], 3), np.uint8)
+    return redraw_caption(np.concatenate([panel, band], axis=0), caption)
+
+
+def band_height(frame_width: int) -> int:
+    """Height of the caption band of a frame `frame_width` pixels wide (even)."""
+    return 2 * int(round(frame_width * BAND_HEIGHT_PER_WIDTH / 2))
+
+
+def redraw_caption(frame: np.ndarray, caption: Caption) -> np.ndarray:
+    """A copy of `frame` (made by `compose`) with its caption band drawn anew for `caption`."""
+    frame = frame.copy()
+    band = frame[-band_height(frame.shape[1]):]
+    band[:] = BLACK
+    _draw_band(band, caption)
+    return frame
+
+
+def _view_grid(views: dict[str, np.ndarray], height: int, width: int) -> np.ndarray:
+    """The views at half size, two per row, in an (height, width) block; one view fills the block."""
+    if len(views) == 1:
+        (name, image), = views.items()
+        return label(cv2.resize(image, (width, height), interpolation=cv2.INTER_LINEAR), name)
+    cell_h, cell_w = height // 2, width // 2
+    grid = np.zeros((height, width, 3), np.uint8)
+    for index, (name, image) in enumerate(list(views.items())[:4]):
+        row, col = divmod(index, 2)
+        cell = cv2.resize(image, (cell_w, cell_h), interpolation=cv2.INTER_LINEAR)
+        grid[row * cell_h:(row + 1) * cell_h, col * cell_w:(col + 1) * cell_w] = label(cell, name)
+    return grid
+
+
+def _draw_band(band: np.ndarray, caption: Caption) -> None:
+    """Prompt and clock on the first line, SUCCESS when reached, the timeline with its events below (in place)."""
+    height, width = band.shape[:2]
+    scale = height / 110
+    thickness = max(1, int(round(scale * 1.5)))
+    margin = int(12 * scale) + 4
+    line_y = int(height * 0.30)
+    clock = f"t {caption.time_s:5.2f} s"
+    (clock_w, _), _ = cv2.getTextSize(clock, cv2.FONT_HERSHEY_SIMPLEX, 0.6 * scale, thickness)
+    succeeded = caption.events.success is not None and caption.time_s >= caption.events.success
+    badge = "SUCCESS" if succeeded else ""
+    (badge_w, _), _ = cv2.getTextSize(badge or " ", cv2.FONT_HERSHEY_SIMPLEX, 0.6 * scale, thickness + 1)
+    prompt_room = width - 3 * margin - clock_w - (badge_w + margin if badge else 0)
+    _put(band, _fit(caption.prompt, prompt_room, 0.6 * scale, thickness), (margin, line_y), 0.6 * scale, WHITE,
+         thickness)
+    _put(band, clock, (width - margin - clock_w, line_y), 0.6 * scale, WHITE, thickness)
+    if badge:
+        _put(band, badge, (width - 2 * margin - clock_w - badge_w, line_y), 0.6 * scale, GREEN, thickness + 1)
+
+    left, right, bar_y = margin, width - margin, int(height * 0.55)
+    duration = max(caption.duration_s, 1e-6)
+    to_x = lambda t: int(round(left + (right - left) * min(max(t / duration, 0.0), 1.0)))  # noqa: E731
+    cv2.line(band, (left, bar_y), (right, bar_y), GREY, thickness, cv2.LINE_AA)
+    cv2.line(band, (left, bar_y), (to_x(caption.time_s), bar_y), WHITE, thickness + 1, cv2.LINE_AA)
+    tick = int(height * 0.12)
+    legend_x, legend_y = left, bar_y + tick + int(16 * scale)
+    for name, time_s in caption.events.items():
+        x = to_x(time_s)
+        colour = EVENT_COLOURS[name]
+        cv2.line(band, (x, bar_y - tick), (x, bar_y + tick), colour, thickness + 1, cv2.LINE_AA)
+        entry = f"{name} {time_s:.2f} s"
+        _put(band, entry, (legend_x, legend_y), 0.45 * scale, colour, thickness)
+        legend_x += cv2.getTextSize(entry + "   ", cv2.FONT_HERSHEY_SIMPLEX, 0.45 * scale, thickness)[0][0]
+    cv2.circle(band, (to_x(caption.time_s), bar_y), max(3, tick // 2), WHITE, -1, cv2.LINE_AA)
+
+
+def _put(image, text, origin, scale, colour, thickness) -> None:
+    cv2.putText(image, text, origin, cv2.FONT_HERSHEY_SIMPLEX, scale, colour, thickness, cv2.LINE_AA)
+
+
+def _fit(text: str, room: int, scale: float, thickness: int) -> str:
+    """`text`, cut with an ellipsis to fit `room` pixels."""
+    if cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, thickness)[0][0] <= room:
+        return text
+    while text and cv2.getTextSize(text + "...", cv2.FONT_HERSHEY_SIMPLEX, scale, thickness)[0][0] > room:
+        text = text[:-1]
+    return text + "..."
