@@ -29,6 +29,14 @@ def write_mp4(path: str | Path, frames: list[np.ndarray], fps: int) -> Path:
     return path
 
 
+def read_mp4(path: str | Path) -> list[np.ndarray]:
+    """The RGB uint8 frames (H, W, 3) of a video file."""
+    import av  # PyAV: only where videos are read
+
+    with av.open(str(path)) as container:
+        return [frame.to_ndarray(format="rgb24") for frame in container.decode(video=0)]
+
+
 def write_png(path: str | Path, rgb: np.ndarray) -> Path:
     """Write an RGB uint8 image (H, W, 3) as PNG."""
     path = Path(path)

@@ -3,7 +3,8 @@
 Every `eval_info.json` under the directory (LeRobot's result of one lerobot-eval run) is joined with the
 `episodes.jsonl` next to it: per (suite, task_id), a log record belongs to episode `seed - start_seed` (the start
 seed is the smallest logged seed) and only episodes below LeRobot's `n_episodes` count, exactly the episodes
-LeRobot scored. Writes `results.json`, `results.md`, `success_rates.png` and `galt_<task>.png` into the directory.
+LeRobot scored. Writes `results.json`, `results.md`, `success_rates.png` and `galt_<task>.png` into the directory,
+and beside each evaluation's videos a copy with the episode's GALT events drawn on (`videos_annotated/`).
 """
 
 from __future__ import annotations
@@ -135,16 +136,21 @@ def join(eval_dir: Path) -> tuple[list[dict], dict]:
     return episodes, {"source": str(eval_dir), "success_mismatches": mismatches}
 
 
-def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
-    cells: dict[tuple[str, str], Cell] = {}
-    sources = []
+def eval_dirs(root: Path) -> list[Path]:
+    """Every lerobot-eval output directory under `root` (those holding an eval_info.json)."""
     # Dot-named folders are staging copies (finished or left by a killed run), never results.
     info_files = sorted(path for path in root.rglob(EVAL_INFO_NAME)
                         if not any(part.startswith(".") for part in path.relative_to(root).parts))
     if not info_files:
         raise FileNotFoundError(f"no {EVAL_INFO_NAME} under {root}")
-    for info_path in info_files:
-        episodes, meta = join(info_path.parent)
+    return [path.parent for path in info_files]
+
+
+def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
+    cells: dict[tuple[str, str], Cell] = {}
+    sources = []
+    for eval_dir in eval_dirs(root):
+        episodes, meta = join(eval_dir)
         sources.append(meta)
         for record in episodes:
             cell = cells.setdefault((record["task"], record["split"]),
@@ -291,12 +297,17 @@ def _save(fig, path: Path) -> Path:
 
 
 def write_report(root: str | Path) -> list[Path]:
-    """Build the report of every evaluation under `root` and write it there; returns the written files."""
+    """Build the report of every evaluation under `root` and write it there, with an annotated copy of each
+    episode video (`lerobot_tavis.eval.annotate`); returns the written files."""
+    from lerobot_tavis.eval.annotate import annotate_videos
+
     root = Path(root)
     report = build_report(root)
     written = plot(report, root)
     written.append(_write_text(root / "results.json", json.dumps(report, indent=2) + "\n"))
     written.append(_write_text(root / "results.md", markdown(report)))
+    for eval_dir in eval_dirs(root):
+        written += annotate_videos(eval_dir)
     return written
 
 

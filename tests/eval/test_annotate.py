@@ -1,0 +1,53 @@
+"""`tavis report` draws each episode's GALT events onto a copy of the videos lerobot-eval wrote."""
+
+import json
+
+import numpy as np
+
+from lerobot_tavis.eval.report import write_report
+from lerobot_tavis.media import read_mp4, write_mp4
+from lerobot_tavis.overlay import EVENT_COLOURS, Caption, band_height, compose
+
+FPS = 20
+
+
+def _record(seed, success, length_steps, gaze=None):
+    return {"robot": "gr1t2", "suite": "tavis_head", "task": "conditional_pick", "task_id": 0, "split": "id",
+            "camera_mode": "head_wrist", "seed": seed, "success": success, "length_steps": length_steps,
+            "prompt": "pick it", "galt_s": 1.0 if gaze else None, "galt_reason": "ok" if gaze else None,
+            "galt_t_head_arrival_s": gaze, "galt_t_hand_onset_s": gaze and gaze + 0.3,
+            "galt_t_hand_arrival_s": gaze and gaze + 1.0}
+
+
+def _live_video(path, n_frames):
+    """What lerobot-eval films: composed frames whose band knows only the clock."""
+    views = {"head": np.full((48, 64, 3), 90, np.uint8)}
+    overview = np.full((48, 64, 3), 160, np.uint8)
+    write_mp4(path, [compose(views, overview, Caption("pick it", i / FPS, 20.0)) for i in range(n_frames)], FPS)
+
+
+def _has(region, colour):
+    return bool(np.any(np.all(np.abs(region.astype(int) - colour) < 40, axis=-1)))
+
+
+def test_videos_get_a_copy_with_the_episode_events(tmp_path):
+    records = [_record(1000, True, 40, gaze=0.5), _record(1001, False, 60)]
+    (tmp_path / "eval_info.json").write_text(json.dumps({"per_task": [
+        {"task_group": "tavis_head", "task_id": 0, "metrics": {"successes": [True, False]}}]}))
+    (tmp_path / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    for ix, record in enumerate(records):
+        _live_video(tmp_path / "videos" / "tavis_head_0" / f"eval_episode_{ix}.mp4", record["length_steps"] + 1)
+
+    written = write_report(tmp_path)
+
+    annotated = [tmp_path / "videos_annotated" / "tavis_head_0" / f"eval_episode_{ix}.mp4" for ix in (0, 1)]
+    assert all(path in written for path in annotated)
+    success_frames, failure_frames = read_mp4(annotated[0]), read_mp4(annotated[1])
+    original = read_mp4(tmp_path / "videos" / "tavis_head_0" / "eval_episode_0.mp4")
+    assert len(success_frames) == 41 and len(failure_frames) == 61
+    band = band_height(original[0].shape[1])
+    assert np.abs(success_frames[5][:-band].astype(int) - original[5][:-band]).mean() < 2  # panel untouched
+    for colour in ("gaze", "reach", "grasp", "success"):
+        assert _has(success_frames[0][-band:], EVENT_COLOURS[colour]), colour
+    assert not _has(original[0][-band:], EVENT_COLOURS["gaze"])
+    assert not any(_has(failure_frames[-1][-band:], EVENT_COLOURS[name]) for name in EVENT_COLOURS)
