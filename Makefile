@@ -20,13 +20,16 @@ $(STAMP): pyproject.toml
 	$(VENV)/bin/python -m pip install -e '.[dev]'
 	touch $(STAMP)
 
-# Headless OpenGL for MuJoCo (EGL on Mesa). Installed only when missing and when apt-get can run.
+# Headless OpenGL for MuJoCo (EGL on Mesa), and Xvfb, the virtual display the viewer's test (and `xvfb-run -a
+# tavis view` on a machine without a desktop) opens its window on. Installed only when missing and when apt-get can run.
 system-deps:
 	@if ldconfig -p | grep -q 'libEGL.so.1' && ldconfig -p | grep -q 'libOpenGL.so.0\|libGL.so.1' \
-		&& ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1; then :; \
+		&& ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1 && command -v Xvfb >/dev/null; then :; \
 	elif command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
-		apt-get update -qq && apt-get install -y -qq --no-install-recommends libegl1 libgl1-mesa-dri libopengl0; \
-	else echo "warning: EGL/Mesa libraries not found (Debian: apt-get install libegl1 libgl1-mesa-dri libopengl0)"; fi
+		{ apt-get update -qq && apt-get install -y -qq --no-install-recommends libegl1 libgl1-mesa-dri libopengl0 \
+			libgl1 xvfb xauth; } || echo "warning: apt-get could not install the OpenGL libraries or Xvfb"; \
+	else echo "warning: EGL/Mesa libraries or Xvfb not found (Debian: apt-get install libegl1 libgl1-mesa-dri" \
+		"libopengl0 libgl1 xvfb xauth)"; fi
 
 demo: $(STAMP)
 	$(VENV)/bin/tavis demo --out outputs/demo

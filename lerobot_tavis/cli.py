@@ -11,7 +11,7 @@ from pathlib import Path
 
 from lerobot_tavis.dataset_tools.features import STORAGES
 from lerobot_tavis.dataset_tools.workers import BACKENDS
-from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, RENAMED_MODES
+from lerobot_tavis.envs.modes import CAMERA_MODES, CAMERA_NAMES, DEFAULT_CAMERA_MODE, RENAMED_MODES, VIEW_CAMERAS
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 from lerobot_tavis.errors import FieldError, TavisError
 
@@ -101,6 +101,22 @@ def _record(args: argparse.Namespace) -> None:
                                    workers=args.workers, backend=args.backend))
     for task, count in manifest.counts().items():
         print(f"{task}: {count['kept']} kept, {count['discarded']} discarded")
+
+
+def _teleop(args: argparse.Namespace) -> None:
+    from lerobot_tavis.teleop import TeleopConfig, teleop
+
+    for line in teleop(TeleopConfig(out_dir=Path(args.out), task=args.task, robot=args.robot, split=args.split,
+                                    episodes=args.episodes, seed_start=args.seed_start,
+                                    keep_failures=args.keep_failures, view=args.view)):
+        print(line)
+
+
+def _view(args: argparse.Namespace) -> None:
+    from lerobot_tavis.viewer import ViewConfig, view
+
+    view(ViewConfig(task=args.task, robot=args.robot, split=args.split, seed=args.seed, driver=args.driver,
+                    camera=None if args.camera == "free" else args.camera))
 
 
 def _convert(args: argparse.Namespace) -> None:
@@ -245,6 +261,28 @@ def build_parser() -> argparse.ArgumentParser:
                      help="local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)")
     rec.add_argument("--out", required=True, help="raw directory; re-running resumes it")
     rec.set_defaults(run=_record)
+
+    tele = commands.add_parser("teleop", help="drive the robot with the keyboard and record raw episodes (a window)")
+    tele.add_argument("--task", required=True, choices=BENCHMARK_TASKS)
+    tele.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
+    tele.add_argument("--split", default="id", choices=["id", "ood_spatial", "ood_init_pose"])
+    tele.add_argument("--episodes", type=int, default=1, help="kept episodes to record (default 1)")
+    tele.add_argument("--seed-start", type=int, default=200_000, help="first seed (default 200000)")
+    tele.add_argument("--keep-failures", action="store_true", help="keep episodes that did not succeed too")
+    tele.add_argument("--view", default="head", choices=[*CAMERA_NAMES, *VIEW_CAMERAS, "free"],
+                      help="the window's camera (default head)")
+    tele.add_argument("--out", required=True, help="raw directory, as `tavis record` writes; re-running adds to it")
+    tele.set_defaults(run=_teleop)
+
+    view = commands.add_parser("view", help="MuJoCo's interactive viewer on one episode (a window)")
+    view.add_argument("--task", required=True, choices=BENCHMARK_TASKS)
+    view.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
+    view.add_argument("--split", default="id", choices=["id", "ood_spatial", "ood_init_pose"])
+    view.add_argument("--seed", type=int, default=1000)
+    view.add_argument("--driver", default="demonstrator", choices=["demonstrator", "paused"])
+    view.add_argument("--camera", default="free", choices=[*CAMERA_NAMES, *VIEW_CAMERAS, "free"],
+                      help="the window's camera (default: the free camera, moved with the mouse)")
+    view.set_defaults(run=_view)
 
     conv = commands.add_parser("convert", help="raw episodes (or an original TAVIS dataset) -> LeRobotDataset v3.0")
     conv.add_argument("raw_dir", nargs="?", help="a `tavis record` output directory")

@@ -13,7 +13,7 @@ import os
 import sys
 from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, wait
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -59,7 +59,7 @@ def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
     for task in cfg.tasks:
         if cfg.split not in task_info(task).splits:
             raise ValueError(f"split of task {task!r} must be one of {task_info(task).splits}, got {cfg.split!r}")
-    manifest = _open_manifest(cfg)
+    manifest = open_manifest(cfg.out_dir, cfg.robot, cfg.split, cfg.seed_start)
     pending: set[Future] = set()
     in_flight = dict.fromkeys(cfg.tasks, 0)
     seeds = {task: _free_seeds(cfg, manifest, task) for task in cfg.tasks}
@@ -82,11 +82,7 @@ def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
                 pending.remove(future)
                 entry, episode = future.result()
                 in_flight[entry.task] -= 1
-                if episode is not None:
-                    entry.file = episode_filename(entry.task, entry.seed)
-                    entry.sha256 = save_episode(cfg.out_dir / entry.file, episode)
-                manifest.add(entry)
-                manifest.save(cfg.out_dir)
+                store_episode(cfg.out_dir, manifest, entry, episode)
                 bar.update(bool(entry.file))
             refill()
     for task, count in manifest.counts().items():
@@ -96,21 +92,50 @@ def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
     return manifest
 
 
-def _open_manifest(cfg: RecordConfig) -> Manifest:
+def open_manifest(out_dir: Path, robot: str, split: str, seed_start: int, command: str = "tavis record") -> Manifest:
     """A new manifest, or the existing one of a compatible recording with its damaged episodes dropped."""
-    if not (cfg.out_dir / "manifest.json").exists():
-        cfg.out_dir.mkdir(parents=True, exist_ok=True)
-        return Manifest(cfg.robot, cfg.split, RECORD_FPS, cfg.seed_start)
-    manifest = Manifest.load(cfg.out_dir)
+    if not (out_dir / "manifest.json").exists():
+        out_dir.mkdir(parents=True, exist_ok=True)
+        return Manifest(robot, split, RECORD_FPS, seed_start)
+    manifest = Manifest.load(out_dir)
     found = (manifest.robot, manifest.split, manifest.seed_start)
-    if found != (cfg.robot, cfg.split, cfg.seed_start):
-        raise ValueError(f"{cfg.out_dir} holds a recording of robot/split/seed_start {found}, not "
-                         f"{(cfg.robot, cfg.split, cfg.seed_start)}: choose another --out")
-    damaged = manifest.damaged(cfg.out_dir)
+    if found != (robot, split, seed_start):
+        raise ValueError(f"{out_dir} holds a recording of robot/split/seed_start {found}, not "
+                         f"{(robot, split, seed_start)}: choose another --out")
+    damaged = manifest.damaged(out_dir)
     for file, problem in damaged.items():
-        print(f"tavis record: {file}: {problem}; recording it again", file=sys.stderr)
+        print(f"{command}: {file}: {problem}; recording it again", file=sys.stderr)
     manifest.episodes = [e for e in manifest.episodes if e.file not in damaged]
     return manifest
+
+
+def store_episode(out_dir: Path, manifest: Manifest, entry: ManifestEntry, episode: RawEpisode | None) -> None:
+    """Write a kept episode's file, then the manifest that lists it (or the discarded seed)."""
+    if episode is not None:
+        entry.file = episode_filename(entry.task, entry.seed)
+        entry.sha256 = save_episode(out_dir / entry.file, episode)
+    manifest.add(entry)
+    manifest.save(out_dir)
+
+
+@dataclass
+class StateLog:
+    """The simulator state after the reset and after every step: what a raw episode checks a replay against."""
+
+    qpos: list = field(default_factory=list)
+    qvel: list = field(default_factory=list)
+    task_state: list = field(default_factory=list)
+
+    def snapshot(self, env) -> None:
+        self.qpos.append(env.data.qpos.copy())
+        self.qvel.append(env.data.qvel.copy())
+        self.task_state.append(env.task_object.task_state().copy())
+
+    def episode(self, env, seed: int, success: bool, actions: np.ndarray) -> RawEpisode:
+        """The raw episode of `env` (a TavisEnv stepped at RECORD_FPS) with these applied actions."""
+        return RawEpisode(env.robot_name, env.task, env.split, seed, env.task_description, RECORD_FPS, success,
+                          np.asarray(actions, dtype=np.float64).reshape(-1, 19), np.array(self.qpos),
+                          np.array(self.qvel), np.array(self.task_state))
 
 
 def _free_seeds(cfg: RecordConfig, manifest: Manifest, task: str) -> Iterator[int]:
@@ -128,19 +153,12 @@ def record_episode(robot: str, task: str, split: str, seed: int,
     from lerobot_tavis.experts.registry import run_episode
 
     env = _env(robot, task, split)
-    qpos, qvel, task_state = [], [], []
-
-    def snapshot() -> None:
-        qpos.append(env.data.qpos.copy())
-        qvel.append(env.data.qvel.copy())
-        task_state.append(env.task_object.task_state().copy())
-
-    result = run_episode(env, seed, on_step=snapshot)
+    states = StateLog()
+    result = run_episode(env, seed, on_step=lambda: states.snapshot(env))
     entry = ManifestEntry(task, seed, result.success, result.length_steps)
     if not (result.success or keep_failures):
         return entry, None
-    return entry, RawEpisode(robot, task, split, seed, env.task_description, RECORD_FPS, result.success,
-                             result.actions, np.array(qpos), np.array(qvel), np.array(task_state))
+    return entry, states.episode(env, seed, result.success, result.actions)
 
 
 _ENVS: dict[tuple[str, str, str], object] = {}

@@ -1,0 +1,148 @@
+"""`tavis teleop`: a person drives the canonical 19-D action with the keyboard and records raw episodes exactly as
+`tavis record` writes them (60 Hz applied actions and simulator states, a manifest with checksums), so
+`tavis convert` turns them into a LeRobotDataset.
+
+Keys, in MuJoCo's viewer window (the view follows the head camera unless `--view` says otherwise):
+
+    W / S       active hand forward / back      (canonical x, HAND_STEP_M per press)
+    A / D       active hand left / right        (canonical y)
+    Q / E       active hand up / down           (canonical z)
+    TAB         switch the active hand (the right hand starts)
+    SPACE       close / open the active hand's gripper
+    arrows      head pitch (up / down) and yaw (left / right), HEAD_STEP_RAD per press
+    0           both hands and the head back to rest, grippers open
+    ENTER       end the episode (kept if it succeeded, or with --keep-failures)
+    BACKSPACE   drop the episode; the next one starts with the next seed
+
+An episode also ends when the task succeeds or its time runs out, as a demonstrator's does. Seeds start at
+`--seed-start` (200000 by default, away from the demonstrators' 100000 and the evaluation's 1000). Gamepads are not
+read yet.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from lerobot_tavis import canonical, checks
+
+HAND_STEP_M = 0.01
+HEAD_STEP_RAD = 0.05
+# GLFW key codes: letters and digits are their ASCII codes.
+KEY_TAB, KEY_ENTER, KEY_BACKSPACE, KEY_SPACE = 258, 257, 259, 32
+KEY_RIGHT, KEY_LEFT, KEY_DOWN, KEY_UP = 262, 263, 264, 265
+HAND_KEYS = {ord("W"): (0, +1), ord("S"): (0, -1), ord("A"): (1, +1), ord("D"): (1, -1),
+             ord("Q"): (2, +1), ord("E"): (2, -1)}  # key -> (canonical axis, sign)
+HEAD_KEYS = {KEY_UP: (canonical.HEAD_PITCH, -1), KEY_DOWN: (canonical.HEAD_PITCH, +1),
+             KEY_LEFT: (canonical.HEAD_YAW, +1), KEY_RIGHT: (canonical.HEAD_YAW, -1)}  # +pitch looks down
+END, DROP = "end", "drop"
+
+
+@dataclass
+class TeleopCommand:
+    """The canonical action a person is holding, changed one key press at a time."""
+
+    action: np.ndarray = field(default_factory=canonical.rest_action)
+    hand: canonical.ArmSlots = canonical.RIGHT
+
+    def press(self, key: int) -> str | None:
+        """Apply one key press; returns END or DROP for the episode keys, None otherwise (unknown keys too)."""
+        if key in HAND_KEYS:
+            axis, sign = HAND_KEYS[key]
+            self.action[self.hand.position.start + axis] += sign * HAND_STEP_M
+        elif key in HEAD_KEYS:
+            index, sign = HEAD_KEYS[key]
+            self.action[index] += sign * HEAD_STEP_RAD
+        elif key == KEY_TAB:
+            self.hand = canonical.LEFT if self.hand is canonical.RIGHT else canonical.RIGHT
+        elif key == KEY_SPACE:
+            closed = self.action[self.hand.gripper] > 0
+            self.action[self.hand.gripper] = canonical.GRIPPER_OPEN if closed else canonical.GRIPPER_CLOSED
+        elif key == ord("0"):
+            self.action = canonical.rest_action()
+        elif key == KEY_ENTER:
+            return END
+        elif key == KEY_BACKSPACE:
+            return DROP
+        return None
+
+
+@dataclass(frozen=True)
+class TeleopConfig:
+    out_dir: Path
+    task: str
+    robot: str = "gr1t2"
+    split: str = "id"
+    episodes: int = 1
+    seed_start: int = 200_000
+    keep_failures: bool = False
+    view: str = "head"  # a camera of the world ("head", "fixed", "overview", ...), or "free"
+
+    def __post_init__(self):
+        checks.integer("episodes", self.episodes, 1)
+        checks.integer("seed_start", self.seed_start, 0)
+
+
+def teleop_episode(env, seed: int, keys: Callable[[], list[int]], show: Callable[[], None]):
+    """One episode of `env` (a TavisEnv at the 60 Hz record rate) driven by the key presses `keys()` returns
+    before each tick, `show()` after each. Returns (how it ended: END, DROP or None for success or time out,
+    success, the applied actions, the StateLog of the episode)."""
+    from lerobot_tavis.dataset_tools.record import StateLog
+
+    env.reset(seed=seed)
+    states, command, actions = StateLog(), TeleopCommand(), []
+    states.snapshot(env)
+    show()
+    for _ in range(env._max_episode_steps):
+        ending = next((result for key in keys() if (result := command.press(key))), None)
+        if ending:
+            return ending, False, actions, states
+        _, _, terminated, truncated, info = env.step(command.action)
+        actions.append(info["applied_action"])
+        states.snapshot(env)
+        show()
+        if terminated or truncated:
+            return None, bool(info["is_success"]), actions, states
+    return None, False, actions, states
+
+
+def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
+           show: Callable[[], None] | None = None) -> list[str]:
+    """Record `cfg.episodes` kept episodes into `cfg.out_dir`; returns each episode's outcome line. Without `keys`
+    and `show` it opens the viewer window (tests pass scripted key presses instead)."""
+    from lerobot_tavis.dataset_tools.raw import ManifestEntry
+    from lerobot_tavis.dataset_tools.record import RECORD_FPS, open_manifest, store_episode
+    from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.viewer import Window, require_display
+
+    if keys is None:
+        require_display("tavis teleop")
+    env = TavisEnv(cfg.task, cfg.robot, split=cfg.split, fps=RECORD_FPS, cameras=())
+    manifest = open_manifest(cfg.out_dir, cfg.robot, cfg.split, cfg.seed_start, command="tavis teleop")
+    seed = max(manifest.tried_seeds(cfg.task), default=cfg.seed_start - 1) + 1
+    outcomes, window = [], None
+    try:
+        if keys is None:
+            env.reset(seed=seed)
+            window = Window(env, None if cfg.view == "free" else cfg.view)
+            keys, show = window.keys, window.show
+        while manifest.kept(cfg.task) < cfg.episodes and (window is None or window.running):
+            ending, success, actions, states = teleop_episode(env, seed, keys, show)
+            if ending == DROP:
+                outcomes.append(f"seed {seed}: dropped")
+            else:
+                kept = success or cfg.keep_failures
+                entry = ManifestEntry(cfg.task, seed, success, len(actions))
+                store_episode(cfg.out_dir, manifest, entry,
+                              states.episode(env, seed, success, actions) if kept else None)
+                outcomes.append(f"seed {seed}: {'success' if success else 'failure'}, "
+                                f"{'kept' if kept else 'not kept'} ({len(actions)} steps)")
+            seed += 1
+    finally:
+        if window is not None:
+            window.close()
+        env.close()
+    return outcomes

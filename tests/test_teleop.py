@@ -1,0 +1,92 @@
+"""`tavis teleop`: the key mapping, and episodes recorded from scripted key presses that `tavis convert` reads."""
+
+import json
+
+import numpy as np
+import pytest
+
+from lerobot_tavis import canonical
+from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+from lerobot_tavis.teleop import (DROP, END, HAND_STEP_M, HEAD_STEP_RAD, KEY_BACKSPACE, KEY_DOWN, KEY_ENTER, KEY_LEFT,
+                                  KEY_SPACE, KEY_TAB, TeleopCommand, TeleopConfig, teleop)
+
+
+def test_keys_move_the_active_hand_the_head_and_the_grippers():
+    command = TeleopCommand()
+    rest = canonical.rest_action()
+    for key in "WWAQ":
+        assert command.press(ord(key)) is None
+    np.testing.assert_allclose(command.action[canonical.RIGHT.position] - rest[canonical.RIGHT.position],
+                               [2 * HAND_STEP_M, HAND_STEP_M, HAND_STEP_M])
+    command.press(KEY_TAB)
+    command.press(ord("S"))
+    command.press(KEY_SPACE)
+    assert command.action[canonical.LEFT.position][0] == pytest.approx(rest[canonical.LEFT.position][0] - HAND_STEP_M)
+    assert command.action[canonical.LEFT.gripper] == canonical.GRIPPER_CLOSED
+    assert command.action[canonical.RIGHT.gripper] == canonical.GRIPPER_OPEN
+    command.press(KEY_SPACE)
+    assert command.action[canonical.LEFT.gripper] == canonical.GRIPPER_OPEN
+    command.press(KEY_DOWN)
+    command.press(KEY_LEFT)
+    assert command.action[canonical.HEAD_PITCH] == pytest.approx(HEAD_STEP_RAD)  # down: +pitch
+    assert command.action[canonical.HEAD_YAW] == pytest.approx(HEAD_STEP_RAD)  # left: +yaw
+    before = command.action.copy()
+    assert command.press(ord("Z")) is None
+    np.testing.assert_array_equal(command.action, before)  # unbound keys change nothing
+    command.press(ord("0"))
+    np.testing.assert_array_equal(command.action, rest)
+    assert (command.press(KEY_ENTER), command.press(KEY_BACKSPACE)) == (END, DROP)
+
+
+def scripted(presses: dict[int, list[int]]):
+    """A key source: the presses listed for each tick (ticks counted across episodes)."""
+    tick = {"n": 0}
+
+    def keys():
+        tick["n"] += 1
+        return presses.get(tick["n"] - 1, [])
+    return keys
+
+
+def test_recorded_episodes_are_raw_episodes_that_convert_reads(tmp_path):
+    # Episode 1 (seed 200000): dropped at tick 5. Episode 2 (seed 200001): the right hand moves forward and up
+    # and the head looks down for 60 ticks, then ENTER ends it: a failure, kept with keep_failures.
+    presses = {5: [KEY_BACKSPACE]}
+    presses.update({6 + t: [ord("W"), ord("Q"), KEY_DOWN] for t in range(0, 30, 3)})
+    presses[6 + 60] = [KEY_ENTER]
+    cfg = TeleopConfig(tmp_path / "raw", "conditional_pick", episodes=1, keep_failures=True)
+    outcomes = teleop(cfg, keys=scripted(presses), show=lambda: None)
+    assert outcomes == ["seed 200000: dropped", "seed 200001: failure, kept (60 steps)"]
+
+    manifest = json.loads((tmp_path / "raw" / "manifest.json").read_text())
+    (entry,) = manifest["episodes"]
+    assert (manifest["fps"], entry["seed"], entry["n_steps"], entry["success"]) == (60, 200001, 60, False)
+
+    root = convert(ConvertConfig(tmp_path / "raw", "local/human", tmp_path / "dataset", image_size=(24, 32),
+                                 cameras=("head",)), progress=False)
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    actions = np.stack(LeRobotDataset("local/human", root=root, video_backend="pyav").hf_dataset["action"])
+    rest = canonical.rest_action()
+    assert len(actions) == 20  # 60 ticks at 60 Hz -> 20 frames at 20 Hz
+    reach = actions[-1][canonical.RIGHT.position] - rest[canonical.RIGHT.position]
+    np.testing.assert_allclose(reach, [10 * HAND_STEP_M, 0, 10 * HAND_STEP_M], atol=1e-6)
+    assert actions[-1][canonical.HEAD_PITCH] == pytest.approx(10 * HEAD_STEP_RAD, abs=1e-6)
+
+
+def test_a_rerun_continues_with_the_next_seed(tmp_path):
+    cfg = TeleopConfig(tmp_path / "raw", "conditional_pick", episodes=1, keep_failures=True)
+    teleop(cfg, keys=scripted({3: [KEY_ENTER]}), show=lambda: None)
+    more = TeleopConfig(tmp_path / "raw", "conditional_pick", episodes=2, keep_failures=True)
+    assert teleop(more, keys=scripted({3: [KEY_ENTER]}), show=lambda: None) == [
+        "seed 200001: failure, kept (3 steps)"]
+
+
+def test_without_a_display_it_says_how_to_get_one(tmp_path, monkeypatch):
+    from lerobot_tavis.viewer import NoDisplayError
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.raises(NoDisplayError, match="xvfb-run -a tavis teleop"):
+        teleop(TeleopConfig(tmp_path / "raw", "conditional_pick"))
+    assert not (tmp_path / "raw").exists()
