@@ -115,8 +115,9 @@ def _teleop(args: argparse.Namespace) -> None:
 def _view(args: argparse.Namespace) -> None:
     from lerobot_tavis.viewer import ViewConfig, view
 
-    view(ViewConfig(task=args.task, robot=args.robot, split=args.split, seed=args.seed, driver=args.driver,
-                    camera=None if args.camera == "free" else args.camera))
+    driver = args.driver or ("policy" if args.policy else "demonstrator")
+    view(ViewConfig(task=args.task, robot=args.robot, split=args.split, seed=args.seed, driver=driver,
+                    policy=args.policy, device=args.device, camera=None if args.camera == "free" else args.camera))
 
 
 def _convert(args: argparse.Namespace) -> None:
@@ -276,10 +277,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     view = commands.add_parser("view", help="MuJoCo's interactive viewer on one episode (a window)")
     view.add_argument("--task", required=True, choices=BENCHMARK_TASKS)
-    view.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
+    view.add_argument("--robot", choices=["gr1t2", "reachy2"], help="default: the checkpoint's, else gr1t2")
     view.add_argument("--split", default="id", choices=["id", "ood_spatial", "ood_init_pose"])
     view.add_argument("--seed", type=int, default=1000)
-    view.add_argument("--driver", default="demonstrator", choices=["demonstrator", "paused"])
+    view.add_argument("--driver", choices=["demonstrator", "policy", "paused"],
+                      help="who acts (default: the policy when --policy is given, else the demonstrator)")
+    view.add_argument("--policy", help="a checkpoint's pretrained_model folder; its camera mode and image size apply")
+    view.add_argument("--device", default="cpu", help="the policy's device (default cpu)")
     view.add_argument("--camera", default="free", choices=[*CAMERA_NAMES, *VIEW_CAMERAS, "free"],
                       help="the window's camera (default: the free camera, moved with the mouse)")
     view.set_defaults(run=_view)

@@ -1,9 +1,10 @@
-"""`tavis view`: MuJoCo's interactive viewer on one episode, the demonstrator driving or the scene paused; and the
-real-time window loop that `tavis teleop` shares.
+"""`tavis view`: MuJoCo's interactive viewer on one episode, driven by the demonstrator or a policy checkpoint, or
+paused; and the real-time window loop that `tavis teleop` shares.
 
 Keys in the window: SPACE pauses and resumes, N starts the next seed, R restarts the episode; the mouse moves the
-free camera; closing the window quits. The viewer needs a display: a desktop session, or a
-virtual one (`xvfb-run -a tavis view ...`). The env runs at the 60 Hz control rate, one tick per frame.
+free camera; closing the window quits. The viewer needs a display: a desktop session, or a virtual one
+(`xvfb-run -a tavis view ...`). With the demonstrator the env runs at the 60 Hz control rate, one tick per frame;
+with a policy at its 20 Hz step rate, the camera mode and image size it was trained with, one step per frame.
 """
 
 from __future__ import annotations
@@ -12,11 +13,14 @@ import os
 import queue
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
+import numpy as np
+
+from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
 from lerobot_tavis.errors import TavisError
 
-CONTROL_HZ = 60
-DRIVERS = ("demonstrator", "paused")
+DRIVERS = ("demonstrator", "policy", "paused")
 KEY_SPACE, KEY_N, KEY_R = 32, 78, 82  # GLFW key codes (letters are their upper-case ASCII codes)
 
 
@@ -33,9 +37,9 @@ def require_display(command: str) -> None:
 class Window:
     """MuJoCo's passive viewer on a TavisEnv's model and data, paced at CONTROL_HZ; key presses (GLFW codes) queue
     up until `keys()` takes them. `camera` (a camera name of the env's world, e.g. "head") fixes the view to it;
-    None leaves the free camera."""
+    None leaves the free camera. `rate_hz`: frames per second of wall time."""
 
-    def __init__(self, env, camera: str | None = None):
+    def __init__(self, env, camera: str | None = None, rate_hz: float = CONTROL_HZ):
         import mujoco
         import mujoco.viewer
 
@@ -45,6 +49,7 @@ class Window:
         if camera is not None:
             self._handle.cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
             self._handle.cam.fixedcamid = env.world.cameras[camera]
+        self._period_s = 1.0 / rate_hz
         self._next_frame = time.perf_counter()
 
     def keys(self) -> list[int]:
@@ -58,9 +63,9 @@ class Window:
         return self._handle.is_running()
 
     def show(self) -> None:
-        """Draw the current state, then wait for the next 1/CONTROL_HZ s tick of wall time."""
+        """Draw the current state, then wait for the next frame's time."""
         self._handle.sync()
-        self._next_frame += 1.0 / CONTROL_HZ
+        self._next_frame += self._period_s
         delay = self._next_frame - time.perf_counter()
         if delay > 0:
             time.sleep(delay)
@@ -71,32 +76,87 @@ class Window:
         self._handle.close()
 
 
+class PolicyDriver:
+    """A LeRobot checkpoint acting on one env's observations the way lerobot-eval runs it: LeRobot's observation
+    conversion, the checkpoint's pre- and post-processors, `select_action` with its action queue."""
+
+    def __init__(self, policy_path: str | Path, device: str = "cpu"):
+        import lerobot.policies  # noqa: F401  (registers the policy types)
+        from lerobot.configs.policies import PreTrainedConfig
+        from lerobot.policies.factory import get_policy_class, make_pre_post_processors
+
+        path = Path(policy_path)
+        if not (path / "config.json").is_file():
+            raise FileNotFoundError(f"{path} holds no config.json: pass a checkpoint's pretrained_model folder")
+        config = PreTrainedConfig.from_pretrained(path)
+        config.device = device
+        self.policy = get_policy_class(config.type).from_pretrained(path, config=config).to(device).eval()
+        self.preprocessor, self.postprocessor = make_pre_post_processors(
+            config, pretrained_path=str(path), preprocessor_overrides={"device_processor": {"device": device}})
+
+    def reset(self) -> None:
+        self.policy.reset()
+
+    def act(self, observation: dict, prompt: str) -> np.ndarray:
+        import torch
+        from lerobot.envs.utils import preprocess_observation
+
+        batch = preprocess_observation({"pixels": {name: image[None] for name, image in observation["pixels"].items()},
+                                        "agent_pos": observation["agent_pos"][None]})
+        batch["task"] = [prompt]
+        with torch.inference_mode():
+            action = self.postprocessor(self.policy.select_action(self.preprocessor(batch)))
+        return action[0].float().cpu().numpy()
+
+
 @dataclass(frozen=True)
 class ViewConfig:
     task: str
-    robot: str = "gr1t2"
+    robot: str | None = None  # None: the checkpoint's when a policy drives, else gr1t2
     split: str = "id"
     seed: int = 1000
     driver: str = "demonstrator"
+    policy: str | None = None  # a checkpoint's pretrained_model folder, for driver "policy"
+    device: str = "cpu"
     camera: str | None = None  # None: the free camera
     max_frames: int | None = None  # stop after this many frames (tests, scripted demos); None: until closed
 
 
 def view(cfg: ViewConfig) -> int:
     """Open the viewer and play episodes until the window closes; returns the number of frames shown."""
+    if cfg.driver not in DRIVERS:
+        raise ValueError(f"driver must be one of {DRIVERS}, got {cfg.driver!r}")
+    if (cfg.driver == "policy") != (cfg.policy is not None):
+        raise ValueError("--policy and --driver policy go together")
     require_display("tavis view")
     os.environ.setdefault("MUJOCO_GL", "egl")
     from lerobot_tavis.envs.env import TavisEnv
     from lerobot_tavis.experts.registry import make_expert
 
-    if cfg.driver not in DRIVERS:
-        raise ValueError(f"driver must be one of {DRIVERS}, got {cfg.driver!r}")
-    env = TavisEnv(cfg.task, cfg.robot, split=cfg.split, fps=CONTROL_HZ, cameras=())
+    if cfg.policy is not None:
+        from lerobot_tavis.eval.protocol import checkpoint_env
+
+        settings = checkpoint_env(cfg.policy)
+        driver, fps = PolicyDriver(cfg.policy, cfg.device), POLICY_HZ
+        env = TavisEnv(cfg.task, cfg.robot or settings.get("robot", "gr1t2"), split=cfg.split, fps=fps,
+                       camera_mode=settings.get("camera_mode", "head_wrist"),
+                       image_size=settings.get("image_size", (480, 640)))
+    else:
+        driver, fps = None, CONTROL_HZ
+        env = TavisEnv(cfg.task, cfg.robot or "gr1t2", split=cfg.split, fps=fps, cameras=())
     seed, paused, frames = cfg.seed, cfg.driver == "paused", 0
-    env.reset(seed=seed)
-    expert = make_expert(env, seed)
-    expert.reset()
-    window = Window(env, cfg.camera)
+
+    def start():
+        observation, _ = env.reset(seed=seed)
+        if driver is not None:
+            driver.reset()
+            return observation, None
+        expert = make_expert(env, seed)
+        expert.reset()
+        return observation, expert
+
+    observation, expert = start()
+    window = Window(env, cfg.camera, rate_hz=fps)
     try:
         while window.running and (cfg.max_frames is None or frames < cfg.max_frames):
             restart = False
@@ -106,11 +166,10 @@ def view(cfg: ViewConfig) -> int:
                 elif key in (KEY_N, KEY_R):
                     seed, restart = seed + (key == KEY_N), True
             if restart:
-                env.reset(seed=seed)
-                expert = make_expert(env, seed)
-                expert.reset()
+                observation, expert = start()
             elif not paused:
-                _, _, terminated, truncated, _ = env.step(expert.act())
+                action = driver.act(observation, env.task_description) if driver else expert.act()
+                observation, _, terminated, truncated, _ = env.step(action)
                 if terminated or truncated:
                     paused = True  # hold the final state on screen; N or R goes on
             window.show()

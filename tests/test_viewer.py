@@ -9,6 +9,7 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 from lerobot_tavis.viewer import NoDisplayError, ViewConfig, view
@@ -57,6 +58,55 @@ def test_the_viewer_plays_in_a_window_follows_a_camera_and_queues_keys(virtual_d
     assert shown["frames"] == 30
     assert shown["elapsed"] >= 30 / 60  # paced at the 60 Hz control rate, not as fast as it can
     assert shown["following"] and shown["keys"] == [[32], []]
+
+
+@pytest.fixture(scope="module")
+def act_checkpoint(tmp_path_factory):
+    """An ACT checkpoint of the compact head + wrists preset after one training step on one demonstration."""
+    from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+    from lerobot_tavis.dataset_tools.record import RecordConfig, record
+    from lerobot_tavis.policy_configs import preset_path
+
+    scratch = tmp_path_factory.mktemp("view_policy")
+    record(RecordConfig(scratch / "raw", "gr1t2", ("conditional_pick",), 1), progress=False)
+    root = convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=(120, 160),
+                                 cameras=("head", "left_wrist", "right_wrist")), progress=False)
+    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train",
+             f"--config_path={preset_path('act_head_wrist_compact')}", "--dataset.repo_id=local/tiny",
+             f"--dataset.root={root}", "--env.task=conditional_pick", "--policy.device=cpu", "--steps=1",
+             "--save_freq=1", "--batch_size=2", "--num_workers=0", f"--output_dir={scratch / 'train'}"]
+    subprocess.run(train, check=True, capture_output=True, env={**os.environ, "MUJOCO_GL": "egl"}, timeout=600)
+    return scratch / "train" / "checkpoints" / "last" / "pretrained_model"
+
+
+def test_a_policy_checkpoint_drives_the_viewer(virtual_display, act_checkpoint):
+    script = ("from lerobot_tavis.viewer import ViewConfig, view\n"
+              f"print(view(ViewConfig(task='conditional_pick', driver='policy', policy={str(act_checkpoint)!r}, "
+              "max_frames=12)))")
+    env = {**os.environ, "DISPLAY": virtual_display, "MUJOCO_GL": "egl"}
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.strip().splitlines()[-1] == "12"
+
+
+def test_a_policy_acts_on_the_env_observations(act_checkpoint):
+    from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.viewer import PolicyDriver
+
+    driver = PolicyDriver(act_checkpoint)
+    env = TavisEnv("conditional_pick", "gr1t2", camera_mode="head_wrist", image_size=(120, 160))
+    observation, _ = env.reset(seed=0)
+    driver.reset()
+    action = driver.act(observation, env.task_description)
+    env.close()
+    assert action.shape == (19,) and np.all(np.isfinite(action))
+    with pytest.raises(FileNotFoundError, match="no config.json"):
+        PolicyDriver(act_checkpoint.parent)
+
+
+def test_policy_and_driver_go_together():
+    with pytest.raises(ValueError, match="go together"):
+        view(ViewConfig(task="conditional_pick", driver="policy"))
 
 
 def test_without_a_display_view_says_how_to_get_one(monkeypatch):
