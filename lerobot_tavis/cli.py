@@ -108,7 +108,7 @@ def _teleop(args: argparse.Namespace) -> None:
 
     for line in teleop(TeleopConfig(out_dir=Path(args.out), task=args.task, robot=args.robot, split=args.split,
                                     episodes=args.episodes, seed_start=args.seed_start,
-                                    keep_failures=args.keep_failures, view=args.view)):
+                                    keep_failures=args.keep_failures, view=args.view, gamepad=args.gamepad)):
         print(line)
 
 
@@ -272,6 +272,8 @@ def build_parser() -> argparse.ArgumentParser:
     tele.add_argument("--keep-failures", action="store_true", help="keep episodes that did not succeed too")
     tele.add_argument("--view", default="head", choices=[*CAMERA_NAMES, *VIEW_CAMERAS, "free"],
                       help="the window's camera (default head)")
+    tele.add_argument("--gamepad", action="store_true",
+                      help="also drive the active hand with a gamepad (LeRobot's controller; needs pygame)")
     tele.add_argument("--out", required=True, help="raw directory, as `tavis record` writes; re-running adds to it")
     tele.set_defaults(run=_teleop)
 

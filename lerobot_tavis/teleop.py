@@ -14,9 +14,13 @@ Keys, in MuJoCo's viewer window (the view follows the head camera unless `--view
     ENTER       end the episode (kept if it succeeded, or with --keep-failures)
     BACKSPACE   drop the episode; the next one starts with the next seed
 
+With `--gamepad`, LeRobot's gamepad controller (`lerobot.teleoperators.gamepad`, which needs pygame) moves the
+active hand too: the left stick in the horizontal plane and the right stick vertically, GAMEPAD_SPEED_M_S at full
+deflection; its close/open buttons drive the active gripper; its success and failure buttons end the episode and
+its re-record button drops it. The keyboard keeps the head and the hand switch.
+
 An episode also ends when the task succeeds or its time runs out, as a demonstrator's does. Seeds start at
-`--seed-start` (200000 by default, away from the demonstrators' 100000 and the evaluation's 1000). Gamepads are not
-read yet.
+`--seed-start` (200000 by default, away from the demonstrators' 100000 and the evaluation's 1000).
 """
 
 from __future__ import annotations
@@ -28,9 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_tavis import canonical, checks
+from lerobot_tavis.errors import TavisError
 
 HAND_STEP_M = 0.01
 HEAD_STEP_RAD = 0.05
+GAMEPAD_SPEED_M_S = 0.3
 # GLFW key codes: letters and digits are their ASCII codes.
 KEY_TAB, KEY_ENTER, KEY_BACKSPACE, KEY_SPACE = 258, 257, 259, 32
 KEY_RIGHT, KEY_LEFT, KEY_DOWN, KEY_UP = 262, 263, 264, 265
@@ -39,6 +45,10 @@ HAND_KEYS = {ord("W"): (0, +1), ord("S"): (0, -1), ord("A"): (1, +1), ord("D"): 
 HEAD_KEYS = {KEY_UP: (canonical.HEAD_PITCH, -1), KEY_DOWN: (canonical.HEAD_PITCH, +1),
              KEY_LEFT: (canonical.HEAD_YAW, +1), KEY_RIGHT: (canonical.HEAD_YAW, -1)}  # +pitch looks down
 END, DROP = "end", "drop"
+
+
+class NoGamepadError(TavisError):
+    """--gamepad was asked for, but pygame or the gamepad itself is missing."""
 
 
 @dataclass
@@ -69,6 +79,47 @@ class TeleopCommand:
             return DROP
         return None
 
+    def move_hand(self, delta_m) -> None:
+        """Move the active hand by (dx, dy, dz) m in the canonical frame."""
+        self.action[self.hand.position] += np.asarray(delta_m, dtype=float)
+
+    def set_gripper(self, closed: bool) -> None:
+        self.action[self.hand.gripper] = canonical.GRIPPER_CLOSED if closed else canonical.GRIPPER_OPEN
+
+
+def apply_gamepad(command: TeleopCommand, controller) -> str | None:
+    """Read one tick of a LeRobot `InputController` (`lerobot.teleoperators.gamepad.gamepad_utils`) into
+    `command`: its deltas move the active hand, its gripper command closes or opens it. Returns END for its success
+    or failure event, DROP for re-record, None otherwise."""
+    from lerobot.teleoperators.utils import TeleopEvents
+
+    controller.update()
+    command.move_hand(controller.get_deltas())
+    gripper = controller.gripper_command()
+    if gripper in ("close", "open"):
+        command.set_gripper(gripper == "close")
+    status = controller.get_episode_end_status()
+    if status in (TeleopEvents.SUCCESS, TeleopEvents.FAILURE):
+        return END
+    if status == TeleopEvents.RERECORD_EPISODE:
+        return DROP
+    return None
+
+
+def lerobot_gamepad():
+    """LeRobot's pygame gamepad controller, started, with steps of GAMEPAD_SPEED_M_S at the 60 Hz record rate."""
+    from lerobot.teleoperators.gamepad.gamepad_utils import GamepadController
+
+    step = GAMEPAD_SPEED_M_S / 60
+    try:
+        controller = GamepadController(x_step_size=step, y_step_size=step, z_step_size=step)
+    except ImportError as error:  # LeRobot's message names the extra that brings pygame
+        raise NoGamepadError(f"--gamepad: {error}") from None
+    controller.start()
+    if not controller.running:
+        raise NoGamepadError("--gamepad: no gamepad found; connect one, or leave out --gamepad for the keyboard alone")
+    return controller
+
 
 @dataclass(frozen=True)
 class TeleopConfig:
@@ -80,16 +131,17 @@ class TeleopConfig:
     seed_start: int = 200_000
     keep_failures: bool = False
     view: str = "head"  # a camera of the world ("head", "fixed", "overview", ...), or "free"
+    gamepad: bool = False  # also read LeRobot's gamepad controller
 
     def __post_init__(self):
         checks.integer("episodes", self.episodes, 1)
         checks.integer("seed_start", self.seed_start, 0)
 
 
-def teleop_episode(env, seed: int, keys: Callable[[], list[int]], show: Callable[[], None]):
+def teleop_episode(env, seed: int, keys: Callable[[], list[int]], show: Callable[[], None], gamepad=None):
     """One episode of `env` (a TavisEnv at the 60 Hz record rate) driven by the key presses `keys()` returns
-    before each tick, `show()` after each. Returns (how it ended: END, DROP or None for success or time out,
-    success, the applied actions, the StateLog of the episode)."""
+    before each tick (and the `gamepad` controller, if any), `show()` after each. Returns (how it ended: END, DROP
+    or None for success or time out, success, the applied actions, the StateLog of the episode)."""
     from lerobot_tavis.dataset_tools.record import StateLog
 
     env.reset(seed=seed)
@@ -98,6 +150,8 @@ def teleop_episode(env, seed: int, keys: Callable[[], list[int]], show: Callable
     show()
     for _ in range(env._max_episode_steps):
         ending = next((result for key in keys() if (result := command.press(key))), None)
+        if gamepad is not None:
+            ending = apply_gamepad(command, gamepad) or ending
         if ending:
             return ending, False, actions, states
         _, _, terminated, truncated, info = env.step(command.action)
@@ -110,9 +164,10 @@ def teleop_episode(env, seed: int, keys: Callable[[], list[int]], show: Callable
 
 
 def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
-           show: Callable[[], None] | None = None) -> list[str]:
+           show: Callable[[], None] | None = None, gamepad=None) -> list[str]:
     """Record `cfg.episodes` kept episodes into `cfg.out_dir`; returns each episode's outcome line. Without `keys`
-    and `show` it opens the viewer window (tests pass scripted key presses instead)."""
+    and `show` it opens the viewer window, and with `cfg.gamepad` LeRobot's gamepad controller (tests pass scripted
+    key presses and controllers instead)."""
     from lerobot_tavis.dataset_tools.raw import ManifestEntry
     from lerobot_tavis.dataset_tools.record import RECORD_FPS, open_manifest, store_episode
     from lerobot_tavis.envs.env import TavisEnv
@@ -120,6 +175,8 @@ def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
 
     if keys is None:
         require_display("tavis teleop")
+    if cfg.gamepad and gamepad is None:
+        gamepad = lerobot_gamepad()
     env = TavisEnv(cfg.task, cfg.robot, split=cfg.split, fps=RECORD_FPS, cameras=())
     manifest = open_manifest(cfg.out_dir, cfg.robot, cfg.split, cfg.seed_start, command="tavis teleop")
     seed = max(manifest.tried_seeds(cfg.task), default=cfg.seed_start - 1) + 1
@@ -130,7 +187,7 @@ def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
             window = Window(env, None if cfg.view == "free" else cfg.view)
             keys, show = window.keys, window.show
         while manifest.kept(cfg.task) < cfg.episodes and (window is None or window.running):
-            ending, success, actions, states = teleop_episode(env, seed, keys, show)
+            ending, success, actions, states = teleop_episode(env, seed, keys, show, gamepad)
             if ending == DROP:
                 outcomes.append(f"seed {seed}: dropped")
             else:
@@ -144,5 +201,7 @@ def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
     finally:
         if window is not None:
             window.close()
+        if gamepad is not None:
+            gamepad.stop()
         env.close()
     return outcomes

@@ -90,3 +90,45 @@ def test_without_a_display_it_says_how_to_get_one(tmp_path, monkeypatch):
     with pytest.raises(NoDisplayError, match="xvfb-run -a tavis teleop"):
         teleop(TeleopConfig(tmp_path / "raw", "conditional_pick"))
     assert not (tmp_path / "raw").exists()
+
+
+class ScriptedGamepad:
+    """A LeRobot InputController whose readings come from a script: (deltas, gripper command, end status) per tick."""
+
+    def __init__(self, ticks):
+        self.ticks, self.reading, self.stopped = list(ticks), None, False
+
+    def update(self):
+        self.reading = self.ticks.pop(0) if self.ticks else ((0.0, 0.0, 0.0), "stay", None)
+
+    def get_deltas(self):
+        return self.reading[0]
+
+    def gripper_command(self):
+        return self.reading[1]
+
+    def get_episode_end_status(self):
+        return self.reading[2]
+
+    def stop(self):
+        self.stopped = True
+
+
+def test_a_gamepad_moves_the_active_hand_closes_its_gripper_and_ends_the_episode(tmp_path):
+    from lerobot.teleoperators.utils import TeleopEvents
+
+    ticks = [((0.001, 0.0, 0.002), "stay", None)] * 30 + [((0.0, 0.0, 0.0), "close", None)] * 5
+    ticks += [((0.0, 0.0, 0.0), "stay", TeleopEvents.FAILURE)]
+    gamepad = ScriptedGamepad(ticks)
+    cfg = TeleopConfig(tmp_path / "raw", "conditional_pick", episodes=1, keep_failures=True)
+    assert teleop(cfg, keys=scripted({0: [KEY_TAB]}), show=lambda: None, gamepad=gamepad) == [
+        "seed 200000: failure, kept (35 steps)"]
+    assert gamepad.stopped
+    from lerobot_tavis.dataset_tools.raw import load_episode
+
+    episode = load_episode(tmp_path / "raw" / "conditional_pick" / "seed_00200000.npz")
+    rest = canonical.rest_action()
+    moved = episode.actions[-1][canonical.LEFT.position] - rest[canonical.LEFT.position]  # TAB: the left hand
+    np.testing.assert_allclose(moved, [0.030, 0.0, 0.060], atol=1e-9)
+    assert episode.actions[-1][canonical.LEFT.gripper] == canonical.GRIPPER_CLOSED
+    np.testing.assert_array_equal(episode.actions[-1][canonical.RIGHT.position], rest[canonical.RIGHT.position])
