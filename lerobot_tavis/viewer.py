@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import queue
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,7 +22,8 @@ from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
 from lerobot_tavis.errors import TavisError
 
 DRIVERS = ("demonstrator", "policy", "paused")
-KEY_SPACE, KEY_N, KEY_R = 32, 78, 82  # GLFW key codes (letters are their upper-case ASCII codes)
+KEY_SPACE, KEY_N, KEY_R = 32, 78, 82
+CLOSE_TIMEOUT_S = 5.0  # GLFW key codes (letters are their upper-case ASCII codes)
 
 
 class NoDisplayError(TavisError):
@@ -44,8 +46,10 @@ class Window:
         import mujoco.viewer
 
         self._pressed: queue.SimpleQueue[int] = queue.SimpleQueue()
+        before = set(threading.enumerate())
         self._handle = mujoco.viewer.launch_passive(env.model, env.data, key_callback=self._pressed.put,
                                                     show_left_ui=False, show_right_ui=False)
+        self._ui_threads = set(threading.enumerate()) - before  # the viewer's own, which draws the window
         if camera is not None:
             self._handle.cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
             self._handle.cam.fixedcamid = env.world.cameras[camera]
@@ -73,7 +77,11 @@ class Window:
             self._next_frame = time.perf_counter()
 
     def close(self) -> None:
+        """Close the window and wait (up to CLOSE_TIMEOUT_S) for the viewer's thread to finish: a process that exits
+        while that thread still tears the window down crashes in GLFW's exit handler."""
         self._handle.close()
+        for thread in self._ui_threads:
+            thread.join(timeout=CLOSE_TIMEOUT_S)
 
 
 class PolicyDriver:

@@ -14,14 +14,19 @@ import pytest
 
 from lerobot_tavis.viewer import NoDisplayError, ViewConfig, view
 
-IN_A_WINDOW = """
+PLAY = """
 import json, time
-from lerobot_tavis.envs.env import TavisEnv
-from lerobot_tavis.viewer import ViewConfig, Window, view
+from lerobot_tavis.viewer import ViewConfig, view
 
 started = time.perf_counter()
 frames = view(ViewConfig(task="conditional_pick", max_frames=30))
-elapsed = time.perf_counter() - started
+print(json.dumps({"frames": frames, "elapsed": time.perf_counter() - started}))
+"""
+FOLLOW = """
+import json
+from lerobot_tavis.envs.env import TavisEnv
+from lerobot_tavis.viewer import Window
+
 env = TavisEnv("conditional_pick", "gr1t2", fps=60, cameras=())
 env.reset(seed=0)
 window = Window(env, camera="head")
@@ -30,8 +35,16 @@ window._pressed.put(32)  # what the viewer's key callback does on SPACE
 keys = [window.keys(), window.keys()]
 window.show()
 window.close()
-print(json.dumps({"frames": frames, "elapsed": elapsed, "following": bool(following), "keys": keys}))
+print(json.dumps({"following": bool(following), "keys": keys}))
 """
+
+
+def in_a_window(code: str, display: str) -> dict:
+    """Run `code` in a child process on `display` (one window per process) and read the JSON it prints last."""
+    env = {**os.environ, "DISPLAY": display, "MUJOCO_GL": "egl"}
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    return json.loads(result.stdout.strip().splitlines()[-1])
 
 
 @pytest.fixture
@@ -49,14 +62,14 @@ def virtual_display():
     server.wait(timeout=10)
 
 
-def test_the_viewer_plays_in_a_window_follows_a_camera_and_queues_keys(virtual_display):
-    env = {**os.environ, "DISPLAY": virtual_display, "MUJOCO_GL": "egl"}
-    result = subprocess.run([sys.executable, "-c", IN_A_WINDOW], capture_output=True, text=True, env=env,
-                            timeout=300)
-    assert result.returncode == 0, result.stderr[-2000:]
-    shown = json.loads(result.stdout.strip().splitlines()[-1])
+def test_the_viewer_plays_the_demonstrator_in_a_window(virtual_display):
+    shown = in_a_window(PLAY, virtual_display)
     assert shown["frames"] == 30
     assert shown["elapsed"] >= 30 / 60  # paced at the 60 Hz control rate, not as fast as it can
+
+
+def test_the_window_follows_a_camera_and_queues_key_presses(virtual_display):
+    shown = in_a_window(FOLLOW, virtual_display)
     assert shown["following"] and shown["keys"] == [[32], []]
 
 
@@ -80,13 +93,10 @@ def act_checkpoint(tmp_path_factory):
 
 
 def test_a_policy_checkpoint_drives_the_viewer(virtual_display, act_checkpoint):
-    script = ("from lerobot_tavis.viewer import ViewConfig, view\n"
-              f"print(view(ViewConfig(task='conditional_pick', driver='policy', policy={str(act_checkpoint)!r}, "
-              "max_frames=12)))")
-    env = {**os.environ, "DISPLAY": virtual_display, "MUJOCO_GL": "egl"}
-    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=300)
-    assert result.returncode == 0, result.stderr[-2000:]
-    assert result.stdout.strip().splitlines()[-1] == "12"
+    script = ("import json\nfrom lerobot_tavis.viewer import ViewConfig, view\n"
+              f"frames = view(ViewConfig(task='conditional_pick', driver='policy', policy={str(act_checkpoint)!r}, "
+              "max_frames=12))\nprint(json.dumps({'frames': frames}))")
+    assert in_a_window(script, virtual_display) == {"frames": 12}
 
 
 def test_a_policy_acts_on_the_env_observations(act_checkpoint):
