@@ -12,7 +12,7 @@ from pathlib import Path
 from lerobot_tavis.dataset_tools.features import STORAGES
 from lerobot_tavis.dataset_tools.workers import BACKENDS
 from lerobot_tavis.envs.modes import CAMERA_MODES, CAMERA_NAMES, DEFAULT_CAMERA_MODE, RENAMED_MODES, VIEW_CAMERAS
-from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, PROTOCOL_SPLITS, split_names
 from lerobot_tavis.errors import FieldError, TavisError
 
 
@@ -225,8 +225,9 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.add_argument("--expert", action="store_true", help="evaluate the scripted demonstrators instead")
     evaluate.add_argument("--robot", choices=["gr1t2", "reachy2"], help="default: the checkpoint's, else gr1t2")
     evaluate.add_argument("--suite", nargs="+", default=["tavis_head"], choices=["tavis_head", "tavis_hands"])
-    evaluate.add_argument("--splits", nargs="+", default=["id", "ood_spatial", "ood_init_pose"],
-                          choices=["id", "ood_spatial", "ood_init_pose"])
+    evaluate.add_argument("--splits", nargs="+", default=list(PROTOCOL_SPLITS), choices=split_names(),
+                          help="default: the reference's id ood_spatial ood_init_pose; also ood_visual (the look "
+                          "changed) and ood_visual:<factor> for one factor alone")
     evaluate.add_argument("--episodes", type=int, default=96, help="episodes per task and split (default 96)")
     evaluate.add_argument("--camera-mode", choices=[*CAMERA_MODES, *RENAMED_MODES],
                           help="default: the checkpoint's, else head_wrist; head_wrist and fixed_wrist are the "
@@ -253,7 +254,7 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
     rec.add_argument("--suite", default="tavis_head", choices=["tavis_head", "tavis_hands"])
     rec.add_argument("--tasks", nargs="+", help="task names (default: every task of --suite)")
-    rec.add_argument("--split", default="id", choices=["id", "ood_spatial", "ood_init_pose"])
+    rec.add_argument("--split", default="id", choices=split_names())
     rec.add_argument("--episodes-per-task", type=int, default=160, help="kept episodes per task (default 160)")
     rec.add_argument("--keep-failures", action="store_true", help="keep failed episodes too (default: discard)")
     rec.add_argument("--seed-start", type=int, default=100_000, help="first seed (evaluation uses 1000..)")
@@ -266,7 +267,7 @@ def build_parser() -> argparse.ArgumentParser:
     tele = commands.add_parser("teleop", help="drive the robot with the keyboard and record raw episodes (a window)")
     tele.add_argument("--task", required=True, choices=BENCHMARK_TASKS)
     tele.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
-    tele.add_argument("--split", default="id", choices=["id", "ood_spatial", "ood_init_pose"])
+    tele.add_argument("--split", default="id", choices=split_names())
     tele.add_argument("--episodes", type=int, default=1, help="kept episodes to record (default 1)")
     tele.add_argument("--seed-start", type=int, default=200_000, help="first seed (default 200000)")
     tele.add_argument("--keep-failures", action="store_true", help="keep episodes that did not succeed too")
@@ -280,7 +281,7 @@ def build_parser() -> argparse.ArgumentParser:
     view = commands.add_parser("view", help="MuJoCo's interactive viewer on one episode (a window)")
     view.add_argument("--task", required=True, choices=BENCHMARK_TASKS)
     view.add_argument("--robot", choices=["gr1t2", "reachy2"], help="default: the checkpoint's, else gr1t2")
-    view.add_argument("--split", default="id", choices=["id", "ood_spatial", "ood_init_pose"])
+    view.add_argument("--split", default="id", choices=split_names())
     view.add_argument("--seed", type=int, default=1000)
     view.add_argument("--driver", choices=["demonstrator", "policy", "paused"],
                       help="who acts (default: the policy when --policy is given, else the demonstrator)")

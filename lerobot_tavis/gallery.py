@@ -5,6 +5,8 @@ grasping-wrist and overview cameras are rendered at the first observation and at
 after the demonstrator first commands a gripper closed). Writes:
 
 - `<out>/gallery/<robot>/<task>.png`: two rows (first observation, grasp) of the four views;
+- `<out>/gallery/<robot>/ood_visual.png`: the first observation of one conditional_pick episode in the `id` look,
+  with each `ood_visual` factor alone, and with all of them (one row each);
 - `<out>/overview.png`: TAVIS-Head tasks seen from the head and fixed cameras, TAVIS-Hands tasks from the head
   camera and the overview camera, and a portrait of each robot.
 """
@@ -21,13 +23,14 @@ from tqdm import tqdm
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.rendering import CameraRig
-from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_info
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, VISUAL_FACTORS, VISUAL_SPLIT, task_info
 from lerobot_tavis.experts.registry import make_expert
 from lerobot_tavis.media import label, write_png
 
 ROBOTS = ("gr1t2", "reachy2")
 GRASP_DELAY_STEPS = 8  # 0.4 s after the close command: the fingers have met the object
 SHEET_VIEWS = ("head", "fixed", "wrist", "overview")  # "wrist": the wrist camera of the arm that grasps
+OOD_VISUAL_TASK, OOD_VISUAL_VIEWS = "conditional_pick", ("head", "fixed", "overview")
 CAPTION_PX, CAPTION_SCALE = 26, 0.5
 TILE_PAD, PANEL_PAD = 3, 6
 HEAD_TINT, HANDS_TINT, ROBOTS_TINT = (190, 215, 235), (190, 230, 215), (245, 215, 190)
@@ -76,6 +79,19 @@ def capture_stills(task: str, robot: str, *, image_size: tuple[int, int] = (240,
     views = {"head": "head", "fixed": "fixed", "wrist": wrist, "overview": "overview"}
     return Stills(task, robot, first={v: first[c] for v, c in views.items()},
                   grasp={v: last[c] for v, c in views.items()}, grasped=closing_arm is not None)
+
+
+def ood_visual_sheet(task: str, robot: str, *, image_size: tuple[int, int] = (240, 320), seed: int = 0) -> np.ndarray:
+    """One labelled row per look of the same episode's first observation: `id`, each ood_visual factor alone, and
+    all factors together (head, fixed and overview views)."""
+    rows = []
+    for split in ("id", *(f"{VISUAL_SPLIT}:{factor}" for factor in VISUAL_FACTORS), VISUAL_SPLIT):
+        env = TavisEnv(task, robot, split=split, image_size=image_size, cameras=OOD_VISUAL_VIEWS)
+        observation, _ = env.reset(seed=seed)
+        env.close()
+        rows.append(np.concatenate([label(observation["pixels"][view], f"{view} - {split}")
+                                    for view in OOD_VISUAL_VIEWS], axis=1))
+    return np.concatenate(rows, axis=0)
 
 
 def robot_portrait(robot: str, image_size: tuple[int, int] = (480, 360)) -> np.ndarray:
@@ -135,6 +151,9 @@ def write_gallery(out_dir: str | Path, *, robots=ROBOTS, tasks=BENCHMARK_TASKS, 
         stills = capture_stills(task, robot, image_size=image_size, seed=seed)
         by_robot.setdefault(robot, {})[task] = stills
         written.append(write_png(out_dir / "gallery" / robot / f"{task}.png", task_sheet(stills)))
+    for robot in robots:
+        sheet = ood_visual_sheet(OOD_VISUAL_TASK, robot, image_size=image_size, seed=seed)
+        written.append(write_png(out_dir / "gallery" / robot / "ood_visual.png", sheet))
     if figure_robot in by_robot and set(by_robot[figure_robot]) == set(BENCHMARK_TASKS):
         portraits = {robot: robot_portrait(robot) for robot in ROBOTS}
         written.append(write_png(out_dir / "overview.png", overview_figure(by_robot[figure_robot], portraits)))

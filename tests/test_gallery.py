@@ -1,12 +1,14 @@
 import numpy as np
 
-from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
-from lerobot_tavis.gallery import SHEET_VIEWS, Stills, capture_stills, overview_figure, write_gallery
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, VISUAL_FACTORS
+from lerobot_tavis.gallery import (OOD_VISUAL_VIEWS, SHEET_VIEWS, Stills, capture_stills, ood_visual_sheet,
+                                   overview_figure, write_gallery)
 
 
 def test_task_sheet_shows_the_first_observation_and_the_grasp(tmp_path):
     written = write_gallery(tmp_path, robots=("gr1t2",), tasks=("conditional_pick",), image_size=(48, 64))
-    assert [p.relative_to(tmp_path).as_posix() for p in written] == ["gallery/gr1t2/conditional_pick.png"]
+    assert [p.relative_to(tmp_path).as_posix() for p in written] == ["gallery/gr1t2/conditional_pick.png",
+                                                                     "gallery/gr1t2/ood_visual.png"]
     assert not (tmp_path / "overview.png").exists()  # the figure needs all eight tasks
     assert not list(tmp_path.rglob("*.partial*"))
 
@@ -40,3 +42,11 @@ def test_overview_figure_holds_every_task_and_both_robots():
     assert figure.ndim == 3 and figure.dtype == np.uint8
     # the head suite's five columns of 80-px views (two rows) fit in the figure, beside the robots panel
     assert figure.shape[1] > 5 * 80 and figure.shape[0] > 4 * 60
+
+
+def test_the_ood_visual_sheet_has_a_row_per_look_and_only_the_looks_differ():
+    sheet = ood_visual_sheet("conditional_pick", "gr1t2", image_size=(48, 64), seed=2)
+    rows = sheet.reshape(len(VISUAL_FACTORS) + 2, 48, len(OOD_VISUAL_VIEWS) * 64, 3)
+    below_labels = rows[:, 12:]
+    for row in below_labels[1:]:
+        assert np.abs(row.astype(int) - below_labels[0]).mean() > 0.5  # every look differs from id

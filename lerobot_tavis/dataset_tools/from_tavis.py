@@ -39,7 +39,7 @@ from lerobot_tavis import canonical, checks
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
 from lerobot_tavis.dataset_tools.staging import staged_directory
-from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SPLITS
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, PROTOCOL_SPLITS
 
 SOURCE_CAMERAS = {
     "observation.images.OBS_HEAD": "head",
@@ -95,8 +95,8 @@ def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, 
     source_root = Path(source_root)
     if not (source_root / "meta" / "info.json").is_file():
         raise FileNotFoundError(f"source_root {source_root} holds no LeRobot dataset (meta/info.json missing)")
-    if split not in SPLITS:
-        raise ValueError(f"split must be one of {SPLITS}, got {split!r}")
+    if split not in PROTOCOL_SPLITS:
+        raise ValueError(f"split must be one of {PROTOCOL_SPLITS}, got {split!r}")
     if task is not None and task not in TASK_CLASSES.values():
         raise ValueError(f"task must be one of {sorted(TASK_CLASSES.values())}, got {task!r}")
     meta = LeRobotDatasetMetadata(f"tavis-benchmark/{source_root.name}", root=source_root)

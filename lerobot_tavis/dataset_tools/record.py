@@ -54,10 +54,10 @@ class RecordConfig:
 
 def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
     """Record (or finish recording) `cfg.out_dir`; returns its manifest."""
-    from lerobot_tavis.envs.tasks.catalog import task_info
+    from lerobot_tavis.envs.tasks.catalog import parse_split, task_info
 
     for task in cfg.tasks:
-        if cfg.split not in task_info(task).splits:
+        if parse_split(cfg.split)[0] not in task_info(task).splits:
             raise ValueError(f"split of task {task!r} must be one of {task_info(task).splits}, got {cfg.split!r}")
     manifest = open_manifest(cfg.out_dir, cfg.robot, cfg.split, cfg.seed_start)
     pending: set[Future] = set()

@@ -22,7 +22,7 @@ from lerobot.envs.utils import _LazyAsyncVectorEnv, freeze_after_episode_end
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.factory import make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
-from lerobot_tavis.envs.tasks.catalog import SPLITS, expand_tasks
+from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 
 ROBOT_NAMES = ("gr1t2", "reachy2")
@@ -43,8 +43,9 @@ class TavisEnvConfig(EnvConfig):
     # Cameras the policy sees: head_wrist (the paper's "headcam": head and both wrists), fixed_wrist (its
     # "fixedcam": fixed workspace camera and both wrists), head_only, fixed_only
     camera_mode: str = DEFAULT_CAMERA_MODE
-    # Episode distribution: id, ood_spatial (wider zones, closer objects) or ood_init_pose (the id scene from a
-    # perturbed hand and head start)
+    # Episode distribution: id, ood_spatial (wider zones, closer objects), ood_init_pose (the id scene from a
+    # perturbed hand and head start) or ood_visual (the id scene with another table, floor, backdrop, lighting and
+    # distractors; ood_visual:table, :floor, :backdrop, :lighting or :distractors for one factor alone)
     split: str = "id"
     # Camera images as height width, pixels (16-4096 each); the cameras' native size is 480 640
     image_size: tuple[int, int] = (480, 640)
@@ -66,8 +67,7 @@ class TavisEnvConfig(EnvConfig):
         if self.robot not in ROBOT_NAMES:
             raise ValueError(f"robot must be one of {ROBOT_NAMES}, got {self.robot!r}")
         self.camera_mode = resolve_camera_mode(self.camera_mode)
-        if self.split not in SPLITS:
-            raise ValueError(f"split must be one of {SPLITS}, got {self.split!r}")
+        parse_split(self.split)  # raises a clear error for an unknown split or ood_visual factor
         if self.fps != 20:
             raise ValueError(f"fps is fixed by the benchmark at 20, got {self.fps}")
         height, width = checks.image_size(self.image_size)

@@ -15,15 +15,15 @@ import mujoco
 import numpy as np
 
 from lerobot_tavis import canonical, checks
-from lerobot_tavis.envs import physics
+from lerobot_tavis.envs import physics, visual_ood
 from lerobot_tavis.envs.control import Controller
 from lerobot_tavis.envs.modes import (CAMERA_NAMES, DEFAULT_CAMERA_MODE, OVERVIEW_CAMERA, VIEW_CAMERAS, mode_cameras,
                                       neck_locked, resolve_camera_mode)
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
+from lerobot_tavis.envs.tasks.catalog import VISUAL_SPLIT, parse_split, task_info
 from lerobot_tavis.envs.tasks.registry import make_task
-from lerobot_tavis.envs.tasks.catalog import task_info
 from lerobot_tavis.envs.world import World, build_world
 
 SETTLE_MAX_S = 1.5
@@ -48,6 +48,7 @@ class _Sim:
         self.controller = Controller(world, neck_locked=neck_locked(camera_mode))
         cameras = {name: world.cameras[name] for name in camera_names}
         self.rig = CameraRig(world.model, cameras, image_size, blacked_out)
+        self.id_look = visual_ood.IdLook.of(world.model)
 
     def advance_tick(self) -> None:
         self.controller.tick(self.data)
@@ -82,7 +83,8 @@ class TavisEnv(gym.Env):
                  cameras: tuple[str, ...] | None = None):
         info = task_info(task)
         camera_mode = resolve_camera_mode(camera_mode)
-        if split not in info.splits:
+        base_split, self._visual_factors = parse_split(split)
+        if base_split not in info.splits:
             raise ValueError(f"split of task {task!r} must be one of {info.splits}, got {split!r}")
         self.camera_names = mode_cameras(camera_mode) if cameras is None else _check_cameras(cameras)
         make_robot(robot)  # validates the name; the model itself is built on the first reset
@@ -105,7 +107,8 @@ class TavisEnv(gym.Env):
         self.metadata = {**self.metadata, "render_fps": fps}
         self._ticks_per_step = physics.CONTROL_HZ // fps
         self._max_episode_steps = max_episode_steps
-        self._task = make_task(task, "id" if split == "ood_init_pose" else split)
+        self._task = make_task(task, "id" if base_split in ("ood_init_pose", VISUAL_SPLIT) else base_split)
+        self.visual_draw = None  # ood_visual: the look drawn for the current episode (visual_ood.VisualDraw)
         self._robot = make_robot(robot)
         self._sim: _Sim | None = None
         self._steps = 0
@@ -125,6 +128,7 @@ class TavisEnv(gym.Env):
         """Start an episode. The scene is drawn from (seed, task), so tasks that get the same seed list (as in
         lerobot-eval) do not share layouts by accident; the same seed always gives the same episode."""
         super().reset(seed=None if seed is None else scene_seed(seed, self.task))
+        look_rng = self.np_random.spawn(1)[0]  # ood_visual's draws; spawning leaves the task's stream untouched
         sim = self._ensure_sim()
         mujoco.mj_resetData(sim.model, sim.data)
         sim.controller.reset(sim.data)
@@ -132,6 +136,9 @@ class TavisEnv(gym.Env):
         self.task_description = self._task.prompt
         mujoco.mj_forward(sim.model, sim.data)
         self._settle(sim)
+        if self._visual_factors:
+            self.visual_draw = visual_ood.apply(sim.model, sim.data, self._visual_factors, look_rng, sim.id_look,
+                                                has_table=self._task.has_table, robot_prefix=self._robot.prefix)
         self._steps = 0
         self._success_s = None
         if self.split == "ood_init_pose":
@@ -203,7 +210,8 @@ class TavisEnv(gym.Env):
 
     def _ensure_sim(self) -> _Sim:
         if self._sim is None:
-            world = build_world(self._robot, self._task, image_size=self.image_size, shadows=self.shadows)
+            world = build_world(self._robot, self._task, image_size=self.image_size, shadows=self.shadows,
+                                visual_variation=bool(self._visual_factors))
             self._sim = _Sim(world, self.camera_mode, self.camera_names, self.image_size,
                              self._task.blacked_out_cameras)
         return self._sim

@@ -40,6 +40,7 @@ KEY_LIGHT_INTENSITY = 2000.0
 KEY_DIFFUSE_AT_REFERENCE = 0.5  # diffuse gain that gives the reference's lit/shadowed contrast at intensity 2000
 KEY_SPECULAR_AT_REFERENCE = 0.6
 SHADOW_MAP_PX = 1024  # the key light's shadow map, when shadows are on
+DOME_AMBIENT = 0.5  # the headlight's ambient, grey
 
 
 @dataclass(frozen=True)
@@ -140,7 +141,7 @@ def add_lights(spec: mujoco.MjSpec, *, shadows: bool) -> None:
     from about 140 to about 30 policy steps/s (`benchmarks/env_speed.py --shadows`); a 512 px shadow map is no
     cheaper than 1024, the cost being MuJoCo's extra lit pass over the frame.
     """
-    spec.visual.headlight.ambient = (0.5, 0.5, 0.5)
+    spec.visual.headlight.ambient = (DOME_AMBIENT,) * 3
     spec.visual.headlight.diffuse = (0.15, 0.15, 0.15)
     spec.visual.headlight.specular = (0.0, 0.0, 0.0)
     spec.visual.quality.shadowsize = SHADOW_MAP_PX

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from lerobot_tavis.envs import physics, scene
+from lerobot_tavis.envs import physics, scene, visual_ood
 from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS
 from lerobot_tavis.envs.robots import Robot
 from lerobot_tavis.envs.tasks.base import Task
@@ -35,13 +35,17 @@ class World:
     robot_joint_qpos: np.ndarray  # qpos addresses of Robot.joint_names(), in that order
 
 
-def build_world(robot: Robot, task: Task, *, image_size: tuple[int, int], shadows: bool = False) -> World:
+def build_world(robot: Robot, task: Task, *, image_size: tuple[int, int], shadows: bool = False,
+                visual_variation: bool = False) -> World:
+    """The compiled world of `task` on `robot`; `visual_variation` adds what the ood_visual split varies."""
     spec = mujoco.MjSpec()
     spec.modelname = f"tavis_{task.info.name}_{robot.name}"
     physics.configure(spec, image_size=image_size)
     scene.add_arena(spec, table=task.has_table, shadows=shadows)
     spec.attach(robot.build_spec(dressed=True), prefix=robot.prefix, frame=spec.worldbody.add_frame())
     task.build(spec)
+    if visual_variation:
+        visual_ood.add_variation_pieces(spec, has_table=task.has_table)
     model = spec.compile()
     physics.set_clip_planes(model)
     task.bind(model)
