@@ -21,6 +21,7 @@ from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.metrics.stats import wilson_interval
 
 EVAL_INFO_NAME = "eval_info.json"
+DELTA_SPLITS = ("ood_spatial", "ood_visual")  # the report gives id minus each, per task
 
 
 @dataclass
@@ -181,13 +182,12 @@ def build_report(root: Path) -> dict:
         low, high = wilson_interval(sum(pooled), len(pooled))
         average[split] = {"n": len(pooled), "successes": sum(pooled), "success_rate": sum(pooled) / len(pooled),
                           "ci_low": low, "ci_high": high}
-    deltas = {}
-    for task in tasks:
-        if (task, "id") in cells and (task, "ood_spatial") in cells:
-            deltas[task] = (cells[(task, "id")].summary()["success_rate"]
-                            - cells[(task, "ood_spatial")].summary()["success_rate"])
+    deltas = {f"id_minus_{split}": {task: cells[(task, "id")].summary()["success_rate"]
+                                    - cells[(task, split)].summary()["success_rate"]
+                                    for task in tasks if (task, "id") in cells and (task, split) in cells}
+              for split in DELTA_SPLITS}
     return {"cells": [cells[(t, s)].summary() for t in tasks for s in splits if (t, s) in cells],
-            "average": average, "id_minus_ood_spatial": deltas, "sources": sources}
+            "average": average, **deltas, "sources": sources}
 
 
 def _pct(rate: float, low: float, high: float) -> str:
@@ -197,23 +197,23 @@ def _pct(rate: float, low: float, high: float) -> str:
 def markdown(report: dict) -> str:
     cells = {(c["task"], c["split"]): c for c in report["cells"]}
     tasks, splits = _order(cells)
-    has_delta = bool(report["id_minus_ood_spatial"])
+    deltas = [split for split in DELTA_SPLITS if report.get(f"id_minus_{split}")]
     robots = sorted({r for s in report["sources"] for r in s["robots"]})
     modes = sorted({m for s in report["sources"] for m in s["camera_modes"]})
     lines = [f"# TAVIS results: {', '.join(robots)}, {', '.join(modes)}", "",
              "Success rate with Wilson 95% interval (n episodes).", "",
-             "| task | " + " | ".join(splits) + (" | id - ood_spatial |" if has_delta else " |"),
-             "|---|" + "---|" * (len(splits) + has_delta)]
+             "| task | " + " | ".join([*splits, *(f"id - {split}" for split in deltas)]) + " |",
+             "|---|" + "---|" * (len(splits) + len(deltas))]
     for task in tasks:
         row = [_pct(c["success_rate"], c["ci_low"], c["ci_high"]) + f" ({c['n']})" if (c := cells.get((task, s)))
                else "" for s in splits]
-        if has_delta:
-            delta = report["id_minus_ood_spatial"].get(task)
+        for split in deltas:
+            delta = report[f"id_minus_{split}"].get(task)
             row.append(f"{100 * delta:+.1f} pp" if delta is not None else "")
         lines.append(f"| {task} | " + " | ".join(row) + " |")
     avg = [_pct(a["success_rate"], a["ci_low"], a["ci_high"]) + f" ({a['n']})" for a in
            (report["average"][s] for s in splits)]
-    lines += ["| **AVERAGE** (pooled) | " + " | ".join(avg) + (" | |" if has_delta else " |")]
+    lines += ["| **AVERAGE** (pooled) | " + " | ".join(avg + [""] * len(deltas)) + " |"]
     lines += _lead_table(cells, tasks, splits, "galt",
                          "GALT (gaze-action lead time, s) over successful episodes of head-camera modes.")
     lines += _lead_table(cells, tasks, splits, "wrist_lead",

@@ -83,3 +83,13 @@ def test_missing_or_corrupt_logs_give_clear_errors(tmp_path):
         join(tmp_path / "a")
     with pytest.raises(FileNotFoundError, match="no eval_info.json"):
         build_report(tmp_path / "a" / "nothing")
+
+
+def test_the_report_gives_the_drop_to_ood_visual_too(tmp_path):
+    _eval_dir(tmp_path / "id", "id", {"conditional_pick": [True] * 8})
+    _eval_dir(tmp_path / "visual", "ood_visual", {"conditional_pick": [True] * 2 + [False] * 6})
+    report = build_report(tmp_path)
+    assert report["id_minus_ood_visual"]["conditional_pick"] == pytest.approx(0.75)
+    assert report["id_minus_ood_spatial"] == {}
+    text = markdown(report)
+    assert "| task | id | ood_visual | id - ood_visual |" in text and "+75.0 pp" in text
