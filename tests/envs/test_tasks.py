@@ -50,7 +50,7 @@ def test_suites_hold_the_reference_tasks():
                                          "clutter_pick_lift", "multi_shelf_scan")
     assert suite_tasks("tavis_hands") == ("peeking_box", "occluded_reach", "blocked_clutter_pick_cube")
     for name in TAVIS_TASKS:
-        assert TASKS[name].splits == ("id", "ood_spatial", "ood_init_pose")
+        assert TASKS[name].splits == ("id", "ood_spatial", "ood_init_pose", "ood_visual")
 
 
 @pytest.mark.parametrize("variant", VARIANTS)
