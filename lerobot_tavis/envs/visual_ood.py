@@ -64,12 +64,11 @@ def add_variation_pieces(spec: mujoco.MjSpec, *, has_table: bool) -> None:
         for name in ("table/top", "table/surface"):
             spec.geom(name).material = TABLE_MATERIAL
     spec.geom("floor/tiles").material = FLOOR_MATERIAL
-    for index, (x, y, yaw) in enumerate(((BACKDROP_DISTANCE_M, 0, 0), (-BACKDROP_DISTANCE_M, 0, 0),
-                                         (0, BACKDROP_DISTANCE_M, 1), (0, -BACKDROP_DISTANCE_M, 1))):
+    d, thin = BACKDROP_DISTANCE_M, 0.01
+    for index, (x, y, half_x, half_y) in enumerate(((d, 0, thin, d), (-d, 0, thin, d), (0, d, d, thin),
+                                                    (0, -d, d, thin))):
         wall = spec.worldbody.add_geom(name=f"{PREFIX}wall{index}", type=mujoco.mjtGeom.mjGEOM_BOX,
-                                       pos=(x, y, BACKDROP_HEIGHT_M / 2))
-        wall.size = (0.01, BACKDROP_DISTANCE_M, BACKDROP_HEIGHT_M / 2) if yaw == 0 else (
-            BACKDROP_DISTANCE_M, 0.01, BACKDROP_HEIGHT_M / 2)
+                                       pos=(x, y, BACKDROP_HEIGHT_M / 2), size=(half_x, half_y, BACKDROP_HEIGHT_M / 2))
         physics.style_geom(wall, physics.VISUAL, group=physics.GROUP_PARKED)
         wall.castshadow = False
         wall.material = BACKDROP_MATERIAL
