@@ -86,9 +86,13 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     deviations = {}
     with staged_directory(cfg.root, overwrite=cfg.overwrite) as staging:
         videos = cfg.storage != "png"
+        # LeRobot's streaming encoder drops frames when its queue is full (it is made for live capture, where a
+        # lagging encoder must not stall the robot); offline, every frame must reach the video, so the queue is
+        # unbounded (0): at most one episode's frames wait in memory.
         dataset = LeRobotDataset.create(cfg.repo_id, fps=cfg.fps, features=features, root=staging,
                                         robot_type=manifest.robot, use_videos=videos, video_backend="pyav",
-                                        rgb_encoder=ft.video_encoder(cfg.storage), streaming_encoding=videos)
+                                        rgb_encoder=ft.video_encoder(cfg.storage), streaming_encoding=videos,
+                                        encoder_queue_maxsize=0)
         episodes = replayed(cfg, entries, cameras, stride)
         try:
             for entry, frames, deviation in tqdm(episodes, total=len(entries), desc=f"convert {cfg.repo_id}",

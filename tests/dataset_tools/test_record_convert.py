@@ -150,6 +150,28 @@ def test_converting_twice_gives_identical_data_whatever_the_workers(raw_dir, tmp
             assert np.array_equal(first[index][image_key(camera)].numpy(), second[index][image_key(camera)].numpy())
 
 
+def test_no_frame_is_lost_when_the_video_encoder_lags(raw_dir, tmp_path, monkeypatch):
+    """LeRobot's streaming encoder drops frames that find its queue full; conversion must not lose any."""
+    import time
+
+    from lerobot.datasets import video_utils
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    encode = video_utils._CameraEncoderThread.run
+
+    def lagging(thread):  # an encoder that starts late, as on a loaded machine: the whole episode queues up
+        time.sleep(3.0)
+        encode(thread)
+
+    monkeypatch.setattr(video_utils._CameraEncoderThread, "run", lagging)
+    root = convert(ConvertConfig(raw_dir, "local/lag", tmp_path / "lag", image_size=IMAGE_SIZE, task="peeking_box",
+                                 cameras=("head",)), progress=False)
+    dataset = LeRobotDataset("local/lag", root=root, video_backend="pyav")
+    assert dataset.num_frames > 60  # more than LeRobot's default queue of 30 frames per episode
+    for index in range(len(dataset)):  # every frame decodes at its own timestamp
+        assert dataset[index][image_key("head")].shape == (3, *IMAGE_SIZE)
+
+
 def test_a_replay_that_ends_differently_is_an_error(raw_dir, tmp_path):
     raw = _copy_raw(raw_dir, tmp_path)
     manifest = raw_files.Manifest.load(raw)
