@@ -2,8 +2,10 @@
 
     python benchmarks/command_footprint.py [--out result.json] -- tavis eval --expert ... --workers 16
 
-Samples the resident memory of the command's process tree (read from /proc) every `--interval` seconds and keeps
-the peak of the sum and the largest process count; CPU time is the tree's user + system time (every descendant
+Samples the memory of the command's process tree (read from /proc) every `--interval` seconds and keeps the peaks
+of two sums: resident memory (RSS, which counts a shared library once per process that maps it) and proportional
+memory (PSS, which splits shared pages among the processes sharing them: what the tree really holds), and the
+largest process count; CPU time is the tree's user + system time (every descendant
 that was waited for is counted by the operating system in its parent's children times). Linux only.
 """
 
@@ -29,19 +31,19 @@ def _children(pid: int) -> list[int]:
     return found
 
 
-def _tree_rss_kib(root: int) -> tuple[int, int]:
-    """(resident KiB summed over the tree, processes in the tree)."""
-    total, count, todo = 0, 0, [root]
+def _tree_memory_kib(root: int) -> tuple[int, int, int]:
+    """(RSS KiB summed over the tree, PSS KiB summed over the tree, processes in the tree)."""
+    rss_total, pss_total, count, todo = 0, 0, 0, [root]
     while todo:
         pid = todo.pop()
         try:
-            status = Path(f"/proc/{pid}/status").read_text()
+            rollup = Path(f"/proc/{pid}/smaps_rollup").read_text()
         except OSError:
             continue
-        rss = next((line.split()[1] for line in status.splitlines() if line.startswith("VmRSS:")), "0")
-        total, count = total + int(rss), count + 1
+        fields = {line.split(":")[0]: int(line.split()[1]) for line in rollup.splitlines()[1:] if line.endswith("kB")}
+        rss_total, pss_total, count = rss_total + fields["Rss"], pss_total + fields["Pss"], count + 1
         todo += _children(pid)
-    return total, count
+    return rss_total, pss_total, count
 
 
 def main() -> None:
@@ -55,10 +57,11 @@ def main() -> None:
         parser.error("give the command to measure after --")
     start = time.perf_counter()
     process = subprocess.Popen(command)
-    peak_kib, peak_processes = 0, 0
+    peak_rss_kib, peak_pss_kib, peak_processes = 0, 0, 0
     while process.poll() is None:
-        rss, count = _tree_rss_kib(process.pid)
-        peak_kib, peak_processes = max(peak_kib, rss), max(peak_processes, count)
+        rss, pss, count = _tree_memory_kib(process.pid)
+        peak_rss_kib, peak_pss_kib = max(peak_rss_kib, rss), max(peak_pss_kib, pss)
+        peak_processes = max(peak_processes, count)
         time.sleep(args.interval)
     wall_s = time.perf_counter() - start
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -66,7 +69,8 @@ def main() -> None:
     result = {"command": " ".join(command), "returncode": process.returncode, "wall_s": round(wall_s, 1),
               "cpu_s": round(cpu_s, 1), "cpu_percent": round(100 * cpu_s / wall_s), "cores": os.cpu_count(),
               "machine_busy_percent": round(100 * cpu_s / wall_s / os.cpu_count(), 1),
-              "peak_rss_gib": round(peak_kib / 2**20, 2), "peak_processes": peak_processes}
+              "peak_rss_gib": round(peak_rss_kib / 2**20, 2), "peak_pss_gib": round(peak_pss_kib / 2**20, 2),
+              "peak_processes": peak_processes}
     print(json.dumps(result))
     if args.out:
         args.out.write_text(json.dumps(result, indent=2) + "\n")
