@@ -2,30 +2,29 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import cv2
 import numpy as np
 
+from lerobot_tavis.atomic import atomic_path
+
 
 def write_mp4(path: str | Path, frames: list[np.ndarray], fps: int) -> Path:
     """Encode RGB uint8 frames (H, W, 3; H and W even) as H.264 MP4."""
     import av  # PyAV: only where videos are written
+
     path = Path(path)
     if not frames:
         raise ValueError(f"no frames to write to {path}")
     height, width = frames[0].shape[:2]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f".{path.name}.partial")
-    with av.open(str(partial), mode="w", format="mp4") as container:
+    with atomic_path(path) as partial, av.open(str(partial), mode="w", format="mp4") as container:
         stream = container.add_stream("libx264", rate=fps)
         stream.width, stream.height, stream.pix_fmt = width, height, "yuv420p"
         stream.options = {"crf": "20", "preset": "veryfast"}
         for frame in frames:
             container.mux(stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(frame), format="rgb24")))
         container.mux(stream.encode())
-    os.replace(partial, path)
     return path
 
 
@@ -39,13 +38,10 @@ def read_mp4(path: str | Path) -> list[np.ndarray]:
 
 def write_png(path: str | Path, rgb: np.ndarray) -> Path:
     """Write an RGB uint8 image (H, W, 3) as PNG."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f".{path.name}.partial.png")
-    if not cv2.imwrite(str(partial), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
-        raise OSError(f"could not write {path}")
-    os.replace(partial, path)
-    return path
+    with atomic_path(path, suffix=".png") as partial:  # OpenCV picks the format from the extension
+        if not cv2.imwrite(str(partial), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
+            raise OSError(f"could not write {path}")
+    return Path(path)
 
 
 def label(image: np.ndarray, text: str) -> np.ndarray:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import zipfile
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -17,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_tavis import canonical
+from lerobot_tavis.atomic import atomic_path, write_text
 from lerobot_tavis.errors import TavisError
 
 FORMAT = "tavis-raw"
@@ -59,13 +59,9 @@ def episode_filename(task: str, seed: int) -> str:
 
 def save_episode(path: str | Path, episode: RawEpisode) -> str:
     """Write `episode` to `path` atomically; returns the file's SHA-256."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f".{path.name}.partial")
-    with open(partial, "wb") as file:
+    with atomic_path(path) as partial, open(partial, "wb") as file:
         np.savez_compressed(file, metadata=np.array(json.dumps(episode.metadata())),
                             **{name: getattr(episode, name) for name in ARRAYS})
-    os.replace(partial, path)
     return file_sha256(path)
 
 
@@ -158,15 +154,12 @@ class Manifest:
 
     def save(self, raw_dir: str | Path) -> None:
         """Write the manifest atomically, with a checksum of its own content (hand edits are detected on load)."""
-        path = Path(raw_dir) / MANIFEST_NAME
-        partial = path.with_name(f".{path.name}.partial")
         document = {"format": FORMAT, "version": FORMAT_VERSION, "robot": self.robot, "split": self.split,
                     "fps": self.fps, "seed_start": self.seed_start, "counts": self.counts(),
                     "episodes": [asdict(e) for e in self.episodes],
                     "discarded": [asdict(e) for e in self.discarded]}
         document["sha256"] = _content_sha256(document)
-        partial.write_text(json.dumps(document, indent=1) + "\n")
-        os.replace(partial, path)
+        write_text(Path(raw_dir) / MANIFEST_NAME, json.dumps(document, indent=1) + "\n")
 
     @classmethod
     def load(cls, raw_dir: str | Path) -> Manifest:

@@ -28,6 +28,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from lerobot_tavis.atomic import write_text
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.dataset_tools.workers import executor
 from lerobot_tavis.envs.tasks.catalog import expand_tasks
@@ -198,9 +199,7 @@ def _keep_chunk(work: Path, result: ChunkResult) -> None:
         video = work / f"{chunk.stem}.videos" / name
         video.parent.mkdir(exist_ok=True)
         video.write_bytes(data)
-    partial = work / f".{chunk.stem}.done.partial"
-    partial.write_text(json.dumps(result.metrics))
-    os.replace(partial, _done_path(work, chunk))
+    write_text(_done_path(work, chunk), json.dumps(result.metrics))
 
 
 def _assemble(cfg, cell_name: str, chunks: list[Chunk], work: Path, started: float) -> None:

@@ -10,12 +10,12 @@ and beside each evaluation's videos a copy with the episode's GALT events drawn 
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from lerobot_tavis.atomic import atomic_path, write_text
 from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.metrics.stats import wilson_interval
@@ -290,9 +290,8 @@ def plot(report: dict, out_dir: Path) -> list[Path]:
 
 
 def _save(fig, path: Path) -> Path:
-    partial = path.with_name(f".{path.stem}.partial.png")
-    fig.savefig(partial, dpi=120)
-    os.replace(partial, path)
+    with atomic_path(path, suffix=".png") as partial:  # matplotlib picks the format from the extension
+        fig.savefig(partial, dpi=120)
     return path
 
 
@@ -304,16 +303,10 @@ def write_report(root: str | Path) -> list[Path]:
     root = Path(root)
     report = build_report(root)
     written = plot(report, root)
-    written.append(_write_text(root / "results.json", json.dumps(report, indent=2) + "\n"))
-    written.append(_write_text(root / "results.md", markdown(report)))
+    written.append(write_text(root / "results.json", json.dumps(report, indent=2) + "\n"))
+    written.append(write_text(root / "results.md", markdown(report)))
     for eval_dir in eval_dirs(root):
         written += annotate_videos(eval_dir)
     return written
 
-
-def _write_text(path: Path, text: str) -> Path:
-    partial = path.with_name(f".{path.name}.partial")
-    partial.write_text(text)
-    os.replace(partial, path)
-    return path
 
