@@ -36,18 +36,19 @@ def episode_errors(predicted: np.ndarray, recorded: np.ndarray) -> dict[str, flo
             for name, (dims, scale) in GROUPS.items()}
 
 
-def replay_open_loop(policy, preprocessor, postprocessor, frames: list[dict], device: str) -> np.ndarray:
-    """The actions `policy` selects, one per frame, when shown the recorded observations in order."""
+def replay_open_loop(driver, frames: list[dict], device: str) -> np.ndarray:
+    """The actions a `viewer.PolicyDriver`'s policy selects, one per frame, when shown the recorded observations
+    (already in LeRobot's tensor layout) in order."""
     import torch
 
-    policy.reset()
+    driver.reset()
     actions = []
     for frame in frames:
         batch = {key: value.unsqueeze(0).to(device) for key, value in frame.items()
                  if key.startswith("observation.")}
         batch["task"] = [frame["task"]]
         with torch.inference_mode():
-            action = postprocessor(policy.select_action(preprocessor(batch)))
+            action = driver.postprocessor(driver.policy.select_action(driver.preprocessor(batch)))
         actions.append(action[0].float().cpu().numpy())
     return np.stack(actions)
 
@@ -61,19 +62,12 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="writes errors.json and traces.npz (predicted and recorded actions)")
     args = parser.parse_args()
 
-    from lerobot.configs.policies import PreTrainedConfig
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
-    from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 
     from lerobot_tavis.dataset_tools.quiet import video_backend
+    from lerobot_tavis.viewer import PolicyDriver
 
-    if not (args.policy / "config.json").is_file():
-        parser.error(f"--policy {args.policy} holds no config.json: pass a checkpoint's pretrained_model folder")
-    config = PreTrainedConfig.from_pretrained(args.policy)
-    config.device = args.device
-    policy = get_policy_class(config.type).from_pretrained(args.policy, config=config).to(args.device).eval()
-    preprocessor, postprocessor = make_pre_post_processors(
-        config, pretrained_path=str(args.policy), preprocessor_overrides={"device_processor": {"device": args.device}})
+    driver = PolicyDriver(args.policy, args.device)  # loads the checkpoint as `tavis view` and lerobot-eval do
     dataset = LeRobotDataset(f"local/{args.dataset.name}", root=args.dataset, video_backend=video_backend())
     episode_of_frame = np.array(dataset.hf_dataset["episode_index"])
 
@@ -81,7 +75,7 @@ def main() -> None:
     for episode in sorted(set(episode_of_frame.tolist()))[: args.episodes]:
         frames = [dataset[int(i)] for i in np.flatnonzero(episode_of_frame == episode)]
         recorded = np.stack([frame["action"].numpy() for frame in frames])
-        predicted = replay_open_loop(policy, preprocessor, postprocessor, frames, args.device)
+        predicted = replay_open_loop(driver, frames, args.device)
         errors = {"episode": episode, "frames": len(frames), **episode_errors(predicted, recorded)}
         results.append(errors)
         traces[f"predicted_{episode}"], traces[f"recorded_{episode}"] = predicted, recorded

@@ -33,13 +33,11 @@ import numpy as np
 
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.errors import TavisError
+from lerobot_tavis.viewer import KEY_BACKSPACE, KEY_DOWN, KEY_ENTER, KEY_LEFT, KEY_RIGHT, KEY_SPACE, KEY_TAB, KEY_UP
 
 HAND_STEP_M = 0.01
 HEAD_STEP_RAD = 0.05
 GAMEPAD_SPEED_M_S = 0.3
-# GLFW key codes: letters and digits are their ASCII codes.
-KEY_TAB, KEY_ENTER, KEY_BACKSPACE, KEY_SPACE = 258, 257, 259, 32
-KEY_RIGHT, KEY_LEFT, KEY_DOWN, KEY_UP = 262, 263, 264, 265
 HAND_KEYS = {ord("W"): (0, +1), ord("S"): (0, -1), ord("A"): (1, +1), ord("D"): (1, -1),
              ord("Q"): (2, +1), ord("E"): (2, -1)}  # key -> (canonical axis, sign)
 HEAD_KEYS = {KEY_UP: (canonical.HEAD_PITCH, -1), KEY_DOWN: (canonical.HEAD_PITCH, +1),

@@ -22,8 +22,11 @@ from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
 from lerobot_tavis.errors import TavisError
 
 DRIVERS = ("demonstrator", "policy", "paused")
-KEY_SPACE, KEY_N, KEY_R = 32, 78, 82
-CLOSE_TIMEOUT_S = 5.0  # GLFW key codes (letters are their upper-case ASCII codes)
+# GLFW key codes, as the viewer's key callback passes them (letters and digits are their ASCII codes)
+KEY_SPACE, KEY_ENTER, KEY_TAB, KEY_BACKSPACE = 32, 257, 258, 259
+KEY_RIGHT, KEY_LEFT, KEY_DOWN, KEY_UP = 262, 263, 264, 265
+KEY_N, KEY_R = ord("N"), ord("R")
+CLOSE_TIMEOUT_S = 5.0
 
 
 class NoDisplayError(TavisError):

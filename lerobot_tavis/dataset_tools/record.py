@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from lerobot_tavis import checks
+from lerobot_tavis import canonical, checks
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
 from lerobot_tavis.dataset_tools.workers import BACKENDS, executor
 
@@ -134,7 +134,7 @@ class StateLog:
     def episode(self, env, seed: int, success: bool, actions: np.ndarray) -> RawEpisode:
         """The raw episode of `env` (a TavisEnv stepped at RECORD_FPS) with these applied actions."""
         return RawEpisode(env.robot_name, env.task, env.split, seed, env.task_description, RECORD_FPS, success,
-                          np.asarray(actions, dtype=np.float64).reshape(-1, 19), np.array(self.qpos),
+                          np.asarray(actions, dtype=np.float64).reshape(-1, canonical.ACTION_DIM), np.array(self.qpos),
                           np.array(self.qvel), np.array(self.task_state))
 
 
