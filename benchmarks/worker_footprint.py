@@ -5,9 +5,10 @@
 
 Each measurement is a fresh Python process, as a worker of `tavis record`, `tavis eval --expert` or LeRobot's async
 vector envs is: it times `import lerobot_tavis.envs.env`, builds a TavisEnv at 96x128 (head and wrist cameras),
-plays one demonstrator episode and reads its peak resident memory (`ru_maxrss`). Prints one line per process, the
-medians, and whether torch or LeRobot was imported. `--no-render` builds the env with no cameras, as the workers of
-`tavis record` and `benchmarks/expert_success.py` do (no GL context).
+plays one demonstrator episode and reads its peak resident memory (`ru_maxrss`) and, with the env still open, its
+resident and proportional memory (`/proc/self/smaps_rollup`: PSS splits shared pages among their sharers).
+Prints one line per process, the medians, and whether torch or LeRobot was imported. `--no-render` builds the env
+with no cameras, as the workers of `tavis record` and `benchmarks/expert_success.py` do (no GL context).
 """
 
 from __future__ import annotations
@@ -30,10 +31,18 @@ def measure(task: str, robot: str, render: bool) -> dict:
 
     env = TavisEnv(task, robot, camera_mode="head_wrist", image_size=(96, 128), cameras=None if render else ())
     result = run_episode(env, seed=0)
+    memory = _smaps_rollup_mib()  # after the episode, the env still open
     env.close()
     return {"import_s": import_s, "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+            "end_rss_mib": memory["Rss"], "end_pss_mib": memory["Pss"],
             "steps": result.length_steps, "success": result.success,
             "heavy": sorted(m for m in ("torch", "lerobot") if m in sys.modules)}
+
+
+def _smaps_rollup_mib() -> dict[str, float]:
+    """This process's memory by kind (Rss, Pss: shared pages split among the processes sharing them), MiB."""
+    lines = open("/proc/self/smaps_rollup").read().splitlines()[1:]
+    return {line.split(":")[0]: int(line.split()[1]) / 1024 for line in lines if line.endswith("kB")}
 
 
 def main() -> None:
@@ -56,7 +65,9 @@ def main() -> None:
     cameras = "no cameras" if args.no_render else "96x128"
     print(f"{args.task} / {args.robot}, {cameras}, {args.repeats} fresh processes: "
           f"import lerobot_tavis.envs.env {statistics.median(r['import_s'] for r in runs):.2f} s, "
-          f"peak resident {statistics.median(r['peak_mib'] for r in runs):.0f} MiB (median); "
+          f"peak resident {statistics.median(r['peak_mib'] for r in runs):.0f} MiB, at the end resident "
+          f"{statistics.median(r['end_rss_mib'] for r in runs):.0f} MiB and proportional "
+          f"{statistics.median(r['end_pss_mib'] for r in runs):.0f} MiB (medians); "
           f"torch/lerobot imported: {runs[0]['heavy'] or 'neither'}")
 
 
