@@ -6,8 +6,9 @@
 #
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
-# demonstrations, as many as the reference's datasets hold per task), STEPS and SAVE_FREQ (the preset's, 6000 and
-# 2000), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), WORK (/tmp/tavis_baseline).
+# demonstrations, as many as the reference's datasets hold per task), STEPS, SAVE_FREQ and BATCH (the preset's, 6000,
+# 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), WORK
+# (/tmp/tavis_baseline).
 #
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
@@ -71,7 +72,7 @@ case "${1:-}" in
   train)
     choose_video_backend
     time train "$WORK/dataset_$CONDITION" "$WORK/train_$CONDITION" ${STEPS:+--steps=$STEPS} \
-      ${SAVE_FREQ:+--save_freq=$SAVE_FREQ}
+      ${SAVE_FREQ:+--save_freq=$SAVE_FREQ} ${BATCH:+--batch_size=$BATCH}
     ;;
   eval)  # every complete checkpoint (up to the one `last` points at), so it may run while training goes on
     last=$(basename "$(readlink "$WORK/train_$CONDITION/checkpoints/last" 2>/dev/null)") || exit 0
