@@ -26,7 +26,8 @@ import numpy as np
 from lerobot_tavis.media import label
 from lerobot_tavis.metrics.galt import GaltResult
 
-MIN_PANEL_HEIGHT = 360  # composed panels are scaled up to at least this many pixels, so the text stays legible
+PANEL_HEIGHT = 360  # composed panels are this many pixels high whatever the cameras' size: the text stays legible,
+# and a filmed frame stays about 1 MB (lerobot-eval holds every frame of its filmed episodes in memory)
 BAND_HEIGHT_PER_WIDTH = 0.11  # the caption band's height, relative to the frame's width
 WHITE, GREY, GREEN, BLACK = (255, 255, 255), (150, 150, 150), (60, 200, 90), (20, 20, 20)
 EVENT_COLOURS = {"gaze": (80, 170, 255), "reach": (255, 170, 60), "grasp": (240, 80, 80), "success": GREEN}
@@ -74,13 +75,18 @@ class Caption:
 def compose(views: dict[str, np.ndarray], overview: np.ndarray, caption: Caption) -> np.ndarray:
     """One annotated frame: the overview, the labelled policy views (each (h, w, 3) like the overview) and the
     caption band; height and width even, as H.264 needs."""
-    scale = max(1, int(np.ceil(MIN_PANEL_HEIGHT / overview.shape[0])))
-    height, width = overview.shape[0] * scale, overview.shape[1] * scale
-    overview = cv2.resize(overview, (width, height), interpolation=cv2.INTER_LINEAR)
+    height, width = panel_size(overview.shape[:2])
+    shrink = height < overview.shape[0]
+    overview = cv2.resize(overview, (width, height), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
     panel = np.concatenate([label(overview, "overview"), _view_grid(views, height, width)], axis=1)
-    panel = panel[: panel.shape[0] // 2 * 2, : panel.shape[1] // 2 * 2]
     band = np.zeros((band_height(panel.shape[1]), panel.shape[1], 3), np.uint8)
     return redraw_caption(np.concatenate([panel, band], axis=0), caption)
+
+
+def panel_size(overview_hw: tuple[int, int]) -> tuple[int, int]:
+    """(height, width) in pixels of the overview's block (and of the views' block beside it): PANEL_HEIGHT high,
+    the overview's aspect ratio, width even."""
+    return PANEL_HEIGHT, 2 * round(overview_hw[1] * PANEL_HEIGHT / overview_hw[0] / 2)
 
 
 def band_height(frame_width: int) -> int:

@@ -2,7 +2,7 @@ import av
 import numpy as np
 
 from lerobot_tavis.demo import run_demo
-from lerobot_tavis.overlay import EVENT_COLOURS, MIN_PANEL_HEIGHT, band_height
+from lerobot_tavis.overlay import EVENT_COLOURS, PANEL_HEIGHT, band_height
 
 
 def test_demo_writes_an_annotated_video_per_task(tmp_path):
@@ -11,8 +11,7 @@ def test_demo_writes_an_annotated_video_per_task(tmp_path):
     assert [p.name for p in written] == ["wait_then_act.mp4", "blocked_clutter_pick_cube.mp4"]
     with av.open(str(tmp_path / "gr1t2" / "blocked_clutter_pick_cube.mp4")) as video:
         frames = [f.to_ndarray(format="rgb24") for f in video.decode(video=0)]
-    scale = int(np.ceil(MIN_PANEL_HEIGHT / 32))
-    panel_h, panel_w = 32 * scale, 2 * 48 * scale  # the overview, then the four views at half size, two per row
+    panel_h, panel_w = PANEL_HEIGHT, 2 * 540  # the 32x48 overview at 360x540, then the views at half size, 2 per row
     assert frames[0].shape == (panel_h + band_height(panel_w), panel_w, 3)
     head_cell = frames[-1][panel_h // 8:panel_h // 2, panel_w // 2:3 * panel_w // 4]  # below its label
     assert head_cell.max() < 40  # the blocked head view stays dark

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from lerobot_tavis.overlay import (EVENT_COLOURS, MIN_PANEL_HEIGHT, Caption, EpisodeEvents, band_height, compose,
+from lerobot_tavis.overlay import (EVENT_COLOURS, PANEL_HEIGHT, Caption, EpisodeEvents, band_height, compose,
                                    redraw_caption)
 
 RED, BLUE, GREEN_VIEW, GREY = (200, 30, 30), (30, 30, 200), (30, 200, 30), (128, 128, 128)
@@ -27,8 +27,7 @@ def has_colour(region, colour, tolerance=40):
 
 def test_layout_overview_left_views_in_a_grid_band_below():
     frame = compose(views(), solid(GREY), Caption("pick the can", 1.0, 20.0))
-    scale = int(np.ceil(MIN_PANEL_HEIGHT / 60))
-    panel_h, panel_w = 60 * scale, 2 * 80 * scale
+    panel_h, panel_w = PANEL_HEIGHT, 2 * 480  # the 60x80 overview scaled to 360x480, the views' block beside it
     assert frame.shape == (panel_h + band_height(panel_w), panel_w, 3)
     assert frame.shape[0] % 2 == 0 and frame.shape[1] % 2 == 0
     below_labels = panel_h // 4  # sample cell centres, away from the name labels in their top-left corners

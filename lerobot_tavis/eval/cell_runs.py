@@ -162,6 +162,7 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
 
     from lerobot_tavis.envs.config import TavisEnvConfig
 
+    _share_cores(cfg.workers)
     policy = policy_config(cfg)
     batch = min(cfg.batch_size, chunk.n)
     with tempfile.TemporaryDirectory(prefix="tavis-chunk-") as scratch:
@@ -179,6 +180,15 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
                   if chunk.first_seed == cfg.seed else {})
         return ChunkResult(chunk, "".join(json.dumps(line) + "\n" for line in lines),
                            {key: task_metrics[key] for key in METRICS}, videos)
+
+
+def _share_cores(jobs: int) -> None:
+    """Give this job's torch its share of the machine's cores. Each process's torch uses every core by default, so
+    `jobs` policy jobs at once oversubscribed them (16-core GPU machine, 5 jobs: 80 torch threads, each job's main
+    process at 200-500% CPU while its env workers waited)."""
+    import torch
+
+    torch.set_num_threads(max(1, (os.cpu_count() or 1) // jobs))
 
 
 def _close_envs() -> None:
