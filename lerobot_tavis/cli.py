@@ -13,7 +13,7 @@ from lerobot_tavis.dataset_tools.features import STORAGES
 from lerobot_tavis.dataset_tools.workers import BACKENDS
 from lerobot_tavis.envs.modes import CAMERA_MODES, CAMERA_NAMES, DEFAULT_CAMERA_MODE, RENAMED_MODES, VIEW_CAMERAS
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, PROTOCOL_SPLITS, split_names
-from lerobot_tavis.errors import FieldError, TavisError
+from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError
 
 
 def _demo(args: argparse.Namespace) -> None:
@@ -41,13 +41,13 @@ def _eval(args: argparse.Namespace) -> None:
     from lerobot_tavis.eval.protocol import ProtocolConfig, checkpoint_env, run_protocol
 
     if bool(args.policy) == bool(args.expert):
-        raise ValueError("give exactly one of --policy PATH and --expert")
+        raise InputError("give exactly one of --policy PATH and --expert")
     trained = {}
     if args.policy:
         if Path(args.policy).exists():
             trained = checkpoint_env(args.policy)
         elif not _looks_like_repo_id(args.policy):
-            raise FileNotFoundError(f"--policy {args.policy}: no such checkpoint directory")
+            raise PathNotFoundError(f"--policy {args.policy}: no such checkpoint directory")
     given = {"robot": args.robot, "camera_mode": args.camera_mode,
              "image_size": _image_size(args.image_size) if args.image_size else None}
     settings = {**EVAL_DEFAULTS, **trained, **{key: value for key, value in given.items() if value is not None}}
@@ -66,7 +66,7 @@ def _policy_option(text: str) -> tuple[str, object]:
 
     name, sign, value = text.partition("=")
     if not (sign and name.strip()):
-        raise ValueError(f"--policy-option must be FIELD=VALUE, e.g. num_inference_steps=10, got {text!r}")
+        raise InputError(f"--policy-option must be FIELD=VALUE, e.g. num_inference_steps=10, got {text!r}")
     try:
         return name.strip(), json.loads(value)
     except json.JSONDecodeError:
@@ -122,11 +122,11 @@ def _view(args: argparse.Namespace) -> None:
 
 def _convert(args: argparse.Namespace) -> None:
     if bool(args.raw_dir) == bool(args.from_tavis):
-        raise ValueError("give exactly one of RAW_DIR (a `tavis record` output) and --from-tavis ROOT")
+        raise InputError("give exactly one of RAW_DIR (a `tavis record` output) and --from-tavis ROOT")
     image_size = _image_size(args.image_size) if args.image_size else None
     if args.from_tavis:
         if args.zero_neck or args.storage != "av1":
-            raise ValueError("--zero-neck and --storage apply to raw episodes, not to --from-tavis")
+            raise InputError("--zero-neck and --storage apply to raw episodes, not to --from-tavis")
         from lerobot_tavis.dataset_tools.from_tavis import convert_from_tavis
 
         root = convert_from_tavis(Path(args.from_tavis), args.repo_id, Path(args.root), fps=args.fps,
@@ -186,7 +186,7 @@ def _train(args: argparse.Namespace) -> None:
 
     path = preset_path(args.preset)
     if args.preset.startswith("pi0") and (missing := missing_pi0_downloads()):
-        raise ValueError(f"pi0 needs {', '.join(missing)}, which are neither in the Hugging Face cache nor "
+        raise InputError(f"pi0 needs {', '.join(missing)}, which are neither in the Hugging Face cache nor "
                          "downloadable here: log in (`hf auth login`, and accept the PaliGemma licence on the Hub) "
                          "or fill HF_HOME on a machine with network access")
     command = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={path}", *args.lerobot_args]
@@ -196,7 +196,7 @@ def _train(args: argparse.Namespace) -> None:
 def _image_size(text: str) -> tuple[int, int]:
     match = re.fullmatch(r"\s*([0-9]+)\s*[xX]\s*([0-9]+)\s*", text)
     if not match or not all(int(side) > 0 for side in match.groups()):
-        raise ValueError(f"--image-size must be HxW in pixels, e.g. 480x640 (height x width), got {text!r}")
+        raise InputError(f"--image-size must be HxW in pixels, e.g. 480x640 (height x width), got {text!r}")
     return int(match[1]), int(match[2])
 
 
@@ -209,7 +209,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--tasks", nargs="+", help="task names (default: the eight TAVIS tasks)")
     demo.add_argument("--image-size", default="240x320", help="HxW of every camera (default 240x320)")
     demo.add_argument("--seed", type=int, default=0)
-    demo.set_defaults(run=_demo)
+    demo.set_defaults(run=_demo, options={"task": "--tasks"})
 
     gallery = commands.add_parser("gallery", help="stills of every task and robot (first observation, grasp) and "
                                   "the README overview figure")
@@ -262,7 +262,7 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--backend", default="local", choices=BACKENDS,
                      help="local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)")
     rec.add_argument("--out", required=True, help="raw directory; re-running resumes it")
-    rec.set_defaults(run=_record)
+    rec.set_defaults(run=_record, options={"task": "--tasks"})
 
     tele = commands.add_parser("teleop", help="drive the robot with the keyboard and record raw episodes (a window)")
     tele.add_argument("--task", required=True, choices=BENCHMARK_TASKS)
@@ -355,7 +355,7 @@ def main(argv: list[str] | None = None) -> None:
         signal.signal(signal.SIGTERM, _exit_on_sigterm)
     try:
         args.run(args)
-    except (ValueError, FileExistsError, FileNotFoundError, TavisError) as error:
+    except TavisError as error:  # the user's input or surroundings; anything else is a bug, with its traceback
         sys.exit(f"tavis {args.command}: error: {_message(error, args)}")
 
 

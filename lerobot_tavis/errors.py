@@ -1,14 +1,38 @@
-"""Errors caused by the user's input or surroundings; the `tavis` command reports them in one line."""
+"""Errors caused by the user's input or surroundings; the `tavis` command reports them in one line.
+
+The family is TavisError and its subclasses: a bad option or config value (FieldError), other input that cannot be
+used, such as a damaged or foreign file (InputError), a path that is missing or already there (PathNotFoundError,
+PathExistsError), and a few modules' own (damaged raw episodes, a replay that differs from its recording, an
+unreachable Hub, no display, OpenGL or gamepad). Those replacing a built-in exception also subclass it (FieldError
+and InputError are ValueErrors), so `except ValueError` keeps working. Any other exception is a bug: the `tavis`
+command lets it through with its traceback.
+"""
 
 
 class TavisError(Exception):
     """Base class: bad input, damaged files, a replay that differs from its recording, an unreachable Hub."""
 
 
-class FieldError(TavisError, ValueError):
+class InputError(TavisError, ValueError):
+    """Input the command cannot use: a bad combination of options, a file that is damaged or not what it should be,
+    a download the command needs that is missing."""
+
+
+class FieldError(InputError):
     """A bad value of one named field of a config or function; the `tavis` command names its option instead."""
 
     def __init__(self, field: str, problem: str):
         super().__init__(f"{field} {problem}")
         self.field = field
         self.problem = problem
+
+    def __reduce__(self):  # pickled whole, so that it crosses from a worker process intact
+        return type(self), (self.field, self.problem)
+
+
+class PathNotFoundError(TavisError, FileNotFoundError):
+    """A file or directory the user named (or the install should hold) is not there."""
+
+
+class PathExistsError(TavisError, FileExistsError):
+    """A destination the user named is there already."""

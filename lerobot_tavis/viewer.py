@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
-from lerobot_tavis.errors import TavisError
+from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError
 
 DRIVERS = ("demonstrator", "policy", "paused")
 # GLFW key codes, as the viewer's key callback passes them (letters and digits are their ASCII codes)
@@ -98,7 +98,7 @@ class PolicyDriver:
 
         path = Path(policy_path)
         if not (path / "config.json").is_file():
-            raise FileNotFoundError(f"{path} holds no config.json: pass a checkpoint's pretrained_model folder")
+            raise PathNotFoundError(f"{path} holds no config.json: pass a checkpoint's pretrained_model folder")
         config = PreTrainedConfig.from_pretrained(path)
         config.device = device
         self.policy = get_policy_class(config.type).from_pretrained(path, config=config).to(device).eval()
@@ -136,9 +136,9 @@ class ViewConfig:
 def view(cfg: ViewConfig) -> int:
     """Open the viewer and play episodes until the window closes; returns the number of frames shown."""
     if cfg.driver not in DRIVERS:
-        raise ValueError(f"driver must be one of {DRIVERS}, got {cfg.driver!r}")
+        raise FieldError("driver", f"must be one of {DRIVERS}, got {cfg.driver!r}")
     if (cfg.driver == "policy") != (cfg.policy is not None):
-        raise ValueError("--policy and --driver policy go together")
+        raise InputError("--policy and --driver policy go together")
     require_display("tavis view")
     os.environ.setdefault("MUJOCO_GL", "egl")
     from lerobot_tavis.envs.env import TavisEnv

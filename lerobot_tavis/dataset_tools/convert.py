@@ -33,7 +33,7 @@ from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.dataset_tools.workers import executor
 from lerobot_tavis.envs.tasks.catalog import task_sort_key
-from lerobot_tavis.errors import TavisError
+from lerobot_tavis.errors import InputError, TavisError
 
 CONVERSION_LOG = "meta/tavis_conversion.json"
 
@@ -77,7 +77,7 @@ def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     entries = sorted((e for e in manifest.episodes if cfg.task in (None, e.task)),
                      key=lambda e: (task_sort_key(e.task), e.seed))
     if not entries:
-        raise ValueError(f"{cfg.raw_dir} holds no episodes" + (f" of task {cfg.task!r}" if cfg.task else ""))
+        raise InputError(f"{cfg.raw_dir} holds no episodes" + (f" of task {cfg.task!r}" if cfg.task else ""))
     damaged = manifest.damaged(cfg.raw_dir)
     if damaged:
         listing = ", ".join(f"{file} ({problem})" for file, problem in damaged.items())

@@ -17,6 +17,7 @@ from collections.abc import Sequence
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.modes import CAMERA_NAMES as CAMERAS
+from lerobot_tavis.errors import FieldError
 STATE_KEY = "observation.state"
 JOINT_POS_KEY = "observation.joint_pos"
 ACTION_KEY = "action"
@@ -39,13 +40,13 @@ def parse_cameras(text: str | Sequence[str]) -> tuple[str, ...]:
     cameras = tuple(c.strip() for c in (text.split(",") if isinstance(text, str) else text) if c.strip())
     unknown = [c for c in cameras if c not in CAMERAS]
     if unknown or not cameras or len(set(cameras)) != len(cameras):
-        raise ValueError(f"cameras must be distinct names among {CAMERAS}, got {text!r}")
+        raise FieldError("cameras", f"must be distinct names among {CAMERAS}, got {text!r}")
     return cameras
 
 
 def check_storage(storage: str) -> str:
     if storage not in STORAGES:
-        raise ValueError(f"storage must be one of {STORAGES}, got {storage!r}")
+        raise FieldError("storage", f"must be one of {STORAGES}, got {storage!r}")
     return storage
 
 
@@ -62,7 +63,7 @@ def frame_stride(source_fps: int, fps: int) -> int:
     """Source frames per dataset frame when a `source_fps` recording becomes an `fps` dataset (fps must divide it)."""
     if not (isinstance(fps, int) and 0 < fps <= source_fps and source_fps % fps == 0):
         divisors = [d for d in range(1, source_fps + 1) if source_fps % d == 0]
-        raise ValueError(f"fps must divide the source rate {source_fps} Hz, one of {divisors}; got {fps!r}")
+        raise FieldError("fps", f"must divide the source rate {source_fps} Hz, one of {divisors}; got {fps!r}")
     return source_fps // fps
 
 

@@ -40,6 +40,7 @@ from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, PROTOCOL_SPLITS
+from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError
 
 SOURCE_CAMERAS = {
     "observation.images.OBS_HEAD": "head",
@@ -74,7 +75,7 @@ def task_name_for_class(class_name: str) -> str:
     try:
         return TASK_CLASSES[class_name]
     except KeyError:
-        raise ValueError(f"unknown TAVIS task class {class_name!r}; known: {sorted(TASK_CLASSES)}") from None
+        raise InputError(f"unknown TAVIS task class {class_name!r}; known: {sorted(TASK_CLASSES)}") from None
 
 
 def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, *, fps: int = 20,
@@ -94,11 +95,11 @@ def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, 
     checks.repo_id(repo_id)
     source_root = Path(source_root)
     if not (source_root / "meta" / "info.json").is_file():
-        raise FileNotFoundError(f"source_root {source_root} holds no LeRobot dataset (meta/info.json missing)")
+        raise PathNotFoundError(f"source_root {source_root} holds no LeRobot dataset (meta/info.json missing)")
     if split not in PROTOCOL_SPLITS:
-        raise ValueError(f"split must be one of {PROTOCOL_SPLITS}, got {split!r}")
+        raise FieldError("split", f"must be one of {PROTOCOL_SPLITS}, got {split!r}")
     if task is not None and task not in TASK_CLASSES.values():
-        raise ValueError(f"task must be one of {sorted(TASK_CLASSES.values())}, got {task!r}")
+        raise FieldError("task", f"must be one of {sorted(TASK_CLASSES.values())}, got {task!r}")
     meta = LeRobotDatasetMetadata(f"tavis-benchmark/{source_root.name}", root=source_root)
     stride = ft.frame_stride(meta.fps, fps)
     _check_source_features(meta.features)
@@ -111,7 +112,7 @@ def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, 
     if task is not None:
         episodes = [(index, name) for index, name in episodes if name == task]
         if not episodes:
-            raise ValueError(f"{source_root} has no episode of task {task!r}")
+            raise InputError(f"{source_root} has no episode of task {task!r}")
 
     quiet_media_libraries()
     with staged_directory(root, overwrite=overwrite) as staging:
@@ -137,16 +138,16 @@ def _check_source_features(features: dict) -> None:
         shapes |= {position: (3,), quaternion: (4,)}
     missing = [key for key in shapes if key not in features]
     if missing:
-        raise ValueError(f"source dataset lacks the TAVIS features {missing}")
+        raise InputError(f"source dataset lacks the TAVIS features {missing}")
     for key, shape in shapes.items():
         if shape is not None and tuple(features[key]["shape"]) != shape:
-            raise ValueError(f"source feature {key} must have shape {shape}, got {tuple(features[key]['shape'])}")
+            raise InputError(f"source feature {key} must have shape {shape}, got {tuple(features[key]['shape'])}")
     cameras = [key for key in SOURCE_CAMERAS if key in features]
     if not cameras:
-        raise ValueError(f"source dataset has none of the cameras {list(SOURCE_CAMERAS)}")
+        raise InputError(f"source dataset has none of the cameras {list(SOURCE_CAMERAS)}")
     not_video = [key for key in cameras if features[key]["dtype"] != "video"]
     if not_video:
-        raise ValueError(f"source cameras must be stored as videos: {not_video}")
+        raise InputError(f"source cameras must be stored as videos: {not_video}")
 
 
 def _robot_type(robot_type: str | None, dataset_name: str) -> str:
@@ -155,7 +156,7 @@ def _robot_type(robot_type: str | None, dataset_name: str) -> str:
         found = [robot for robot in NECK if robot in text.lower()]
         if len(found) == 1:
             return found[0]
-    raise ValueError(f"cannot tell the robot (one of {sorted(NECK)}) from robot_type {robot_type!r} or the "
+    raise InputError(f"cannot tell the robot (one of {sorted(NECK)}) from robot_type {robot_type!r} or the "
                      f"dataset name {dataset_name!r}")
 
 
@@ -163,11 +164,11 @@ def _image_size(features: dict, cameras: dict[str, str], image_size: tuple[int, 
     if image_size is not None:
         height, width = image_size
         if height < 1 or width < 1:
-            raise ValueError(f"image_size must be (height, width) with both >= 1, got {image_size!r}")
+            raise FieldError("image_size", f"must be (height, width) with both >= 1, got {image_size!r}")
         return int(height), int(width)
     sizes = {tuple(features[key]["shape"][:2]) for key in cameras}
     if len(sizes) != 1:
-        raise ValueError(f"source cameras differ in size {sorted(sizes)}: pass image_size")
+        raise InputError(f"source cameras differ in size {sorted(sizes)}: pass image_size")
     return sizes.pop()
 
 
@@ -195,14 +196,14 @@ def _neck_indices(joint_names: list[str], robot: str) -> list[int]:
 def _reference_neck(robot: str, count: int) -> list[int]:
     indices = list(NECK[robot][1])
     if max(indices) >= count:
-        raise ValueError(f"{robot} joint vector has {count} joints, too few for the reference neck indices {indices}")
+        raise InputError(f"{robot} joint vector has {count} joints, too few for the reference neck indices {indices}")
     return indices
 
 
 def _episode_task(episode: dict) -> str:
     tasks = list(episode["tasks"])
     if len(tasks) != 1:
-        raise ValueError(f"source episode {episode['episode_index']} must have one task, got {tasks}")
+        raise InputError(f"source episode {episode['episode_index']} must have one task, got {tasks}")
     return task_name_for_class(tasks[0])
 
 
@@ -278,4 +279,4 @@ def _decode(path: Path, timestamps_s: np.ndarray, fps: int) -> Iterator[np.ndarr
             yield frame.to_ndarray(format="rgb24")
             target = next(pending, None)
     if target is not None:
-        raise ValueError(f"{path}: no video frame at {target:.4f} s")
+        raise InputError(f"{path}: no video frame at {target:.4f} s")

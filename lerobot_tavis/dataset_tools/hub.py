@@ -16,7 +16,7 @@ from urllib.parse import quote
 from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.features import JOINT_POS_KEY, SPLIT_KEY, STATE_KEY, TASK_NAME_KEY
 from lerobot_tavis.envs.tasks.catalog import TASKS, task_sort_key
-from lerobot_tavis.errors import TavisError
+from lerobot_tavis.errors import InputError, PathNotFoundError, TavisError
 
 LICENSE = "cc-by-4.0"
 TAGS = ("lerobot", "tavis", "robotics")
@@ -57,7 +57,7 @@ def dataset_card(dataset, *, provenance: str = PROVENANCE) -> str:
     meta = dataset.meta
     missing = [key for key in (TASK_NAME_KEY, SPLIT_KEY) if key not in meta.features]
     if missing:
-        raise ValueError(f"{dataset.root} is not a TAVIS dataset: it lacks the features {missing}")
+        raise InputError(f"{dataset.root} is not a TAVIS dataset: it lacks the features {missing}")
     front_matter = DatasetCardData(
         license=LICENSE, tags=["LeRobot", *TAGS], task_categories=["robotics"],
         configs=[{"config_name": "default", "data_files": "data/*/*.parquet"}],
@@ -147,7 +147,7 @@ def pull_dataset(repo_id: str, root: str | Path | None = None, revision: str | N
 def _check_dataset_root(root: str | Path) -> Path:
     root = Path(root)
     if not (root / "meta" / "info.json").is_file() or not any(root.glob("data/*/*.parquet")):
-        raise FileNotFoundError(f"{root} is not a LeRobotDataset: it needs meta/info.json and data/*/*.parquet "
+        raise PathNotFoundError(f"{root} is not a LeRobotDataset: it needs meta/info.json and data/*/*.parquet "
                                 "(a dataset written and finalize()d by LeRobot)")
     return root
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from lerobot_tavis import canonical
 from lerobot_tavis.atomic import atomic_path, write_text
-from lerobot_tavis.errors import TavisError
+from lerobot_tavis.errors import PathNotFoundError, TavisError
 
 FORMAT = "tavis-raw"
 FORMAT_VERSION = 1
@@ -165,7 +165,7 @@ class Manifest:
     def load(cls, raw_dir: str | Path) -> Manifest:
         path = Path(raw_dir) / MANIFEST_NAME
         if not path.is_file():
-            raise FileNotFoundError(f"{path} not found: is {raw_dir} a directory written by `tavis record`?")
+            raise PathNotFoundError(f"{path} not found: is {raw_dir} a directory written by `tavis record`?")
         try:
             document = json.loads(path.read_text())
             recorded = document.pop("sha256", None)

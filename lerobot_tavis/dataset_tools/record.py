@@ -22,6 +22,7 @@ from tqdm import tqdm
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
 from lerobot_tavis.dataset_tools.workers import BACKENDS, executor
+from lerobot_tavis.errors import FieldError, InputError
 
 RECORD_FPS = 60
 
@@ -45,7 +46,7 @@ class RecordConfig:
         checks.integer("seed_start", self.seed_start, 0)
         checks.choice("backend", self.backend, BACKENDS)
         if not self.tasks:
-            raise ValueError("tasks must name at least one task")
+            raise FieldError("tasks", "must name at least one task")
 
     @property
     def max_attempts(self) -> int:
@@ -58,7 +59,7 @@ def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
 
     for task in cfg.tasks:
         if parse_split(cfg.split)[0] not in task_info(task).splits:
-            raise ValueError(f"split of task {task!r} must be one of {task_info(task).splits}, got {cfg.split!r}")
+            raise FieldError("split", f"of task {task!r} must be one of {task_info(task).splits}, got {cfg.split!r}")
     manifest = open_manifest(cfg.out_dir, cfg.robot, cfg.split, cfg.seed_start)
     pending: set[Future] = set()
     in_flight = dict.fromkeys(cfg.tasks, 0)
@@ -100,7 +101,7 @@ def open_manifest(out_dir: Path, robot: str, split: str, seed_start: int, comman
     manifest = Manifest.load(out_dir)
     found = (manifest.robot, manifest.split, manifest.seed_start)
     if found != (robot, split, seed_start):
-        raise ValueError(f"{out_dir} holds a recording of robot/split/seed_start {found}, not "
+        raise InputError(f"{out_dir} holds a recording of robot/split/seed_start {found}, not "
                          f"{(robot, split, seed_start)}: choose another --out")
     damaged = manifest.damaged(out_dir)
     for file, problem in damaged.items():

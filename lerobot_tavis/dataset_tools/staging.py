@@ -14,6 +14,8 @@ import uuid
 from collections.abc import Iterator
 from pathlib import Path
 
+from lerobot_tavis.errors import PathExistsError
+
 
 @contextlib.contextmanager
 def staged_directory(destination: str | Path, *, overwrite: bool = False) -> Iterator[Path]:
@@ -23,7 +25,7 @@ def staged_directory(destination: str | Path, *, overwrite: bool = False) -> Ite
     destination = Path(destination).absolute()
     clear_leftovers(destination)
     if destination.exists() and not overwrite:
-        raise FileExistsError(f"{destination} already exists (pass --overwrite to replace it)")
+        raise PathExistsError(f"{destination} already exists (pass --overwrite to replace it)")
     destination.parent.mkdir(parents=True, exist_ok=True)
     staging = destination.with_name(f".{destination.name}.partial-{os.getpid()}-{uuid.uuid4().hex[:8]}")
     try:

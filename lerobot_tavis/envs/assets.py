@@ -11,6 +11,7 @@ from pathlib import Path
 import mujoco
 
 from lerobot_tavis.envs import physics
+from lerobot_tavis.errors import PathNotFoundError
 
 ASSET_DIR = Path(__file__).resolve().parent.parent / "assets"
 
@@ -19,7 +20,7 @@ def asset_file(relative: str) -> str:
     """Absolute path of a packaged asset, e.g. `asset_file("ycb/soup_can.obj")`."""
     path = ASSET_DIR / relative
     if not path.is_file():
-        raise FileNotFoundError(
+        raise PathNotFoundError(
             f"asset {relative!r} is missing from {ASSET_DIR}: the lerobot_env_tavis install is incomplete "
             "(reinstall it, e.g. pip install --force-reinstall lerobot_env_tavis)")
     return str(path)

@@ -23,6 +23,7 @@ from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.factory import make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split
+from lerobot_tavis.errors import FieldError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 
 ROBOT_NAMES = ("gr1t2", "reachy2")
@@ -65,11 +66,11 @@ class TavisEnvConfig(EnvConfig):
     def __post_init__(self):
         expand_tasks(self.task)  # raises a clear error for an unknown task or suite
         if self.robot not in ROBOT_NAMES:
-            raise ValueError(f"robot must be one of {ROBOT_NAMES}, got {self.robot!r}")
+            raise FieldError("robot", f"must be one of {ROBOT_NAMES}, got {self.robot!r}")
         self.camera_mode = resolve_camera_mode(self.camera_mode)
         parse_split(self.split)  # raises a clear error for an unknown split or ood_visual factor
         if self.fps != 20:
-            raise ValueError(f"fps is fixed by the benchmark at 20, got {self.fps}")
+            raise FieldError("fps", f"is fixed by the benchmark at 20, got {self.fps}")
         height, width = checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, self.fps)
         self.features = {"action": PolicyFeature(FeatureType.ACTION, (canonical.ACTION_DIM,)),

@@ -25,6 +25,7 @@ from lerobot_tavis.envs.robots import make_robot
 from lerobot_tavis.envs.tasks.catalog import VISUAL_SPLIT, parse_split, task_info
 from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.world import World, build_world
+from lerobot_tavis.errors import FieldError
 
 SETTLE_MAX_S = 1.5
 SETTLE_MIN_S = 0.1
@@ -85,14 +86,15 @@ class TavisEnv(gym.Env):
         camera_mode = resolve_camera_mode(camera_mode)
         base_split, self._visual_factors = parse_split(split)
         if base_split not in info.splits:
-            raise ValueError(f"split of task {task!r} must be one of {info.splits}, got {split!r}")
+            raise FieldError("split", f"of task {task!r} must be one of {info.splits}, got {split!r}")
         self.camera_names = mode_cameras(camera_mode) if cameras is None else _check_cameras(cameras)
         make_robot(robot)  # validates the name; the model itself is built on the first reset
         height, width = checks.image_size(image_size)
         if render_mode not in (None, "rgb_array"):
-            raise ValueError(f"render_mode must be 'rgb_array' or None, got {render_mode!r}")
+            raise FieldError("render_mode", f"must be 'rgb_array' or None, got {render_mode!r}")
         if not (isinstance(fps, int) and fps > 0 and physics.CONTROL_HZ % fps == 0):
-            raise ValueError(f"fps must divide the {physics.CONTROL_HZ} Hz control rate (20, 30, 60, ...), got {fps!r}")
+            raise FieldError("fps", f"must divide the {physics.CONTROL_HZ} Hz control rate (20, 30, 60, ...), "
+                                    f"got {fps!r}")
         max_episode_steps = checks.episode_steps(episode_length_s, fps)
 
         self.task = task
@@ -270,7 +272,7 @@ def _check_cameras(cameras) -> tuple[str, ...]:
     cameras = tuple(cameras)
     known = CAMERA_NAMES + VIEW_CAMERAS
     if not set(cameras) <= set(known) or len(set(cameras)) != len(cameras):
-        raise ValueError(f"cameras must be distinct names among {known}, got {cameras!r}")
+        raise FieldError("cameras", f"must be distinct names among {known}, got {cameras!r}")
     return cameras
 
 

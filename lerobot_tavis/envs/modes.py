@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import warnings
 
+from lerobot_tavis.errors import FieldError
+
 CAMERA_NAMES = ("head", "fixed", "left_wrist", "right_wrist")
 # Cameras for people (gallery, videos), never part of a camera mode's observation.
 OVERVIEW_CAMERA = "overview"
@@ -41,7 +43,7 @@ def mode_cameras(camera_mode: str) -> tuple[str, ...]:
     try:
         return CAMERA_MODES[camera_mode]
     except KeyError:
-        raise ValueError(f"camera_mode must be one of {list(CAMERA_MODES)}, got {camera_mode!r}") from None
+        raise FieldError("camera_mode", f"must be one of {list(CAMERA_MODES)}, got {camera_mode!r}") from None
 
 
 def neck_locked(camera_mode: str) -> bool:

@@ -7,6 +7,12 @@ import os
 import mujoco
 import numpy as np
 
+from lerobot_tavis.errors import TavisError
+
+
+class NoOpenGLError(TavisError, RuntimeError):
+    """MuJoCo could not create an OpenGL context: the machine's graphics setup, not a bug."""
+
 
 class CameraRig:
     """Renders the named cameras of a model at one image size; `blacked_out` cameras yield black frames unrendered."""
@@ -42,7 +48,7 @@ class CameraRig:
             try:
                 self._renderer = mujoco.Renderer(self._model, height=self.height, width=self.width)
             except mujoco.FatalError as error:
-                raise RuntimeError(
+                raise NoOpenGLError(
                     f"MuJoCo could not create an OpenGL context ({error}). MuJoCo picks its backend when it is "
                     "first imported: set MUJOCO_GL=egl (or osmesa) in the environment, or import "
                     f"lerobot_tavis.envs before mujoco. MUJOCO_GL is {os.environ.get('MUJOCO_GL')!r} now."

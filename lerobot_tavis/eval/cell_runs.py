@@ -32,6 +32,7 @@ from lerobot_tavis.atomic import write_text
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.dataset_tools.workers import executor
 from lerobot_tavis.envs.tasks.catalog import expand_tasks
+from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
 
@@ -143,12 +144,15 @@ def policy_config(cfg):
     import lerobot.policies  # noqa: F401  (registers the policy types that from_pretrained looks up)
     from lerobot.configs.policies import PreTrainedConfig
 
-    policy = PreTrainedConfig.from_pretrained(cfg.policy_path)
+    try:
+        policy = PreTrainedConfig.from_pretrained(cfg.policy_path)
+    except FileNotFoundError as error:  # e.g. a folder without config.json; LeRobot's message names it
+        raise PathNotFoundError(str(error)) from error
     policy.pretrained_path = Path(cfg.policy_path)
     policy.device = cfg.device
     for name, value in cfg.policy_options:  # e.g. num_inference_steps=10, use_amp=true
         if not hasattr(policy, name):
-            raise ValueError(f"--policy-option {name}: the {policy.type} policy has no such field")
+            raise InputError(f"--policy-option {name}: the {policy.type} policy has no such field")
         setattr(policy, name, value)
     return policy
 

@@ -18,6 +18,7 @@ from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.workers import BACKENDS
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.physics import POLICY_HZ
+from lerobot_tavis.errors import InputError
 from lerobot_tavis.eval.cell_runs import policy_config, run_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
@@ -88,7 +89,7 @@ def checkpoint_env(policy_path: str | Path) -> dict:
     try:
         env = json.loads(path.read_text()).get("env") or {}
     except json.JSONDecodeError as error:
-        raise ValueError(f"{path}: not a JSON file ({error.msg})") from None
+        raise InputError(f"{path}: not a JSON file ({error.msg})") from None
     if env.get("type") != "tavis":
         return {}
     found = {key: env[key] for key in ("robot", "camera_mode", "image_size") if key in env}

@@ -17,6 +17,7 @@ import numpy as np
 
 from lerobot_tavis.atomic import atomic_path, write_text
 from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
+from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.metrics.stats import wilson_interval
 
@@ -83,10 +84,10 @@ def read_episode_log(path: Path) -> list[dict]:
         try:
             record = json.loads(line)
         except json.JSONDecodeError as error:
-            raise ValueError(f"{path}:{number}: not a JSON line ({error.msg})") from None
+            raise InputError(f"{path}:{number}: not a JSON line ({error.msg})") from None
         missing = [name for name in RECORD_FIELDS if not isinstance(record, dict) or name not in record]
         if missing:
-            raise ValueError(f"{path}:{number}: not an episode record (missing {', '.join(missing)})")
+            raise InputError(f"{path}:{number}: not an episode record (missing {', '.join(missing)})")
         records.append(record)
     return records
 
@@ -97,14 +98,14 @@ def read_eval_info(path: Path) -> dict:
         info = json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as error:
         reason = f"{error.msg} at line {error.lineno}" if isinstance(error, json.JSONDecodeError) else "not text"
-        raise ValueError(f"{path}: not a JSON file ({reason})") from None
+        raise InputError(f"{path}: not a JSON file ({reason})") from None
     try:
         usable = all("task_group" in task and isinstance(task["task_id"], int)
                      and isinstance(task["metrics"]["successes"], list) for task in info["per_task"])
     except (KeyError, TypeError):
         usable = False
     if not usable:
-        raise ValueError(f"{path}: not a lerobot-eval {EVAL_INFO_NAME} (it needs per_task entries with task_group, "
+        raise InputError(f"{path}: not a lerobot-eval {EVAL_INFO_NAME} (it needs per_task entries with task_group, "
                          "task_id and metrics.successes)")
     return info
 
@@ -114,7 +115,7 @@ def join(eval_dir: Path) -> tuple[list[dict], dict]:
     info = read_eval_info(eval_dir / EVAL_INFO_NAME)
     log_path = eval_dir / EPISODE_LOG_NAME
     if not log_path.exists():
-        raise FileNotFoundError(f"{log_path} is missing: run the evaluation with the tavis env's episode log")
+        raise PathNotFoundError(f"{log_path} is missing: run the evaluation with the tavis env's episode log")
     by_task: dict[tuple[str, int], list[dict]] = {}
     for record in read_episode_log(log_path):
         by_task.setdefault((record["suite"], record["task_id"]), []).append(record)
@@ -124,12 +125,12 @@ def join(eval_dir: Path) -> tuple[list[dict], dict]:
         scored = task["metrics"]["successes"]
         records = by_task.get(key, [])
         if not records:
-            raise ValueError(f"{log_path} has no episode of {key[0]} task {key[1]}")
+            raise InputError(f"{log_path} has no episode of {key[0]} task {key[1]}")
         start = min(r["seed"] for r in records)
         latest = {r["seed"] - start: r for r in records}  # a repeated seed: the last record wins
         for ix, success in enumerate(scored):
             if ix not in latest:
-                raise ValueError(f"{log_path}: episode {ix} of {key[0]} task {key[1]} (seed {start + ix}) "
+                raise InputError(f"{log_path}: episode {ix} of {key[0]} task {key[1]} (seed {start + ix}) "
                                  "was scored by LeRobot but not logged")
             record = {**latest[ix], "episode_ix": ix}
             mismatches += bool(record["success"]) != bool(success)
@@ -143,7 +144,7 @@ def eval_dirs(root: Path) -> list[Path]:
     info_files = sorted(path for path in root.rglob(EVAL_INFO_NAME)
                         if not any(part.startswith(".") for part in path.relative_to(root).parts))
     if not info_files:
-        raise FileNotFoundError(f"no {EVAL_INFO_NAME} under {root}")
+        raise PathNotFoundError(f"no {EVAL_INFO_NAME} under {root}")
     return [path.parent for path in info_files]
 
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lerobot_tavis.errors import InputError
 from lerobot_tavis.experts.base import Expert
 from lerobot_tavis.experts.hands_tasks import BlockedClutterExpert, OccludedReachExpert, PeekingBoxExpert
 from lerobot_tavis.experts.head_tasks import ClutterExpert, ConditionalPickExpert, ShelfExpert, WaitThenActExpert
@@ -28,7 +29,7 @@ def make_expert(env, seed: int) -> Expert:
     try:
         cls = EXPERTS[env.task]
     except KeyError:
-        raise ValueError(f"no demonstrator for task {env.task!r}; tasks with one: {sorted(EXPERTS)}") from None
+        raise InputError(f"no demonstrator for task {env.task!r}; tasks with one: {sorted(EXPERTS)}") from None
     return cls(env, np.random.default_rng([seed, 0x7A715]))
 
 

@@ -30,6 +30,7 @@ from pathlib import Path
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.modes import CAMERA_MODES, RENAMED_MODES, mode_cameras, neck_locked, resolve_camera_mode
+from lerobot_tavis.errors import InputError
 
 PRESET_DIR = Path(__file__).parent
 POLICIES = ("diffusion", "pi0")
@@ -59,7 +60,7 @@ def preset_path(name: str) -> Path:
     if mode in RENAMED_MODES:
         name = f"{policy}_{resolve_camera_mode(mode)}"
     if name not in presets():
-        raise ValueError(f"unknown preset {name!r}; presets: {', '.join(preset_names())}")
+        raise InputError(f"unknown preset {name!r}; presets: {', '.join(preset_names())}")
     return PRESET_DIR / f"{name}.json"
 
 

@@ -43,8 +43,11 @@ def test_task_spec_expands_to_suites():
                                             ({"camera_mode": "eye"}, "camera_mode must be one of"),
                                             ({"split": "ood"}, "split must be one of")])
 def test_bad_config_values_are_rejected(kwargs, message):
-    with pytest.raises(ValueError, match=message):
+    from lerobot_tavis.errors import FieldError
+
+    with pytest.raises(ValueError, match=message) as error:  # what lerobot-train / lerobot-eval see
         TavisEnvConfig(**kwargs)
+    assert isinstance(error.value, FieldError) and error.value.field == next(iter(kwargs))
 
 
 def test_sync_create_envs_wraps_every_sub_env_and_runs():

@@ -10,6 +10,7 @@ import pytest
 
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.cli import main
+from lerobot_tavis.errors import FieldError, InputError, PathExistsError, PathNotFoundError, TavisError
 
 REPO_ID = "must be <owner>/<name> on the Hugging Face Hub"
 
@@ -170,3 +171,80 @@ def test_real_actions_of_any_numeric_type_are_accepted():
     rest = canonical.rest_action()
     for action in (rest, rest.astype(np.float32), list(rest), tuple(rest), rest.astype(object)):
         np.testing.assert_allclose(canonical.validate_action(action), rest, rtol=1e-6)
+
+
+def _command_raising(error: BaseException):
+    def run(args):
+        raise error
+    return run
+
+
+@pytest.mark.parametrize("error,message", [
+    (InputError("the input is bad"), "the input is bad"),
+    (FieldError("workers", "must be an integer >= 1, got 0"), "--workers must be an integer >= 1, got 0"),
+    (PathNotFoundError("/data/raw not found"), "/data/raw not found"),
+    (PathExistsError("/data/out already exists"), "/data/out already exists"),
+    (TavisError("cannot reach the Hub"), "cannot reach the Hub"),
+])
+def test_an_error_of_the_family_is_one_line(monkeypatch, tmp_path, error, message):
+    from lerobot_tavis import cli
+
+    monkeypatch.setattr(cli, "_report", _command_raising(error))
+    assert _refused(["report", str(tmp_path)]) == f"tavis report: error: {message}"
+
+
+@pytest.mark.parametrize("bug", [ValueError("operands could not be broadcast together"), FileNotFoundError("/tmp/x"),
+                                 FileExistsError("/tmp/y"), KeyError("seed"), RuntimeError("internal")])
+def test_any_other_error_inside_a_command_propagates(monkeypatch, tmp_path, bug):
+    from lerobot_tavis import cli
+
+    monkeypatch.setattr(cli, "_report", _command_raising(bug))
+    with pytest.raises(type(bug)) as raised:
+        main(["report", str(tmp_path)])
+    assert raised.value is bug  # not turned into a one-line exit
+
+
+def test_the_family_keeps_the_builtin_exceptions_it_replaced():
+    assert issubclass(FieldError, InputError) and issubclass(InputError, ValueError)
+    assert issubclass(PathNotFoundError, FileNotFoundError) and issubclass(PathExistsError, FileExistsError)
+    assert all(issubclass(cls, TavisError) for cls in (FieldError, InputError, PathNotFoundError, PathExistsError))
+
+
+def test_a_missing_eval_dir_is_one_line_without_traceback(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "lerobot_tavis.cli", "report", str(tmp_path)],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == [f"tavis report: error: no eval_info.json under {tmp_path}"]
+
+
+def test_a_bug_inside_a_command_keeps_its_traceback(tmp_path):
+    code = ("import sys; from lerobot_tavis import cli\n"
+            "def bug(args): raise ValueError('a bug, not the user')\n"
+            "cli._report = bug\n"
+            "cli.main(sys.argv[1:])\n")
+    result = subprocess.run([sys.executable, "-c", code, "report", str(tmp_path)], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 1
+    assert "Traceback" in result.stderr and result.stderr.rstrip().endswith("ValueError: a bug, not the user")
+    assert "tavis report: error:" not in result.stderr
+
+
+def test_user_errors_still_name_the_problem_in_one_line(tmp_path):
+    out = tmp_path / "out"
+    missing = tmp_path / "no" / "checkpoint"
+    assert _refused(["eval", "--policy", str(missing), "--out", str(out)]) == (
+        f"tavis eval: error: --policy {missing}: no such checkpoint directory")
+    assert _refused(["eval", "--expert", "--image-size", "480by640", "--out", str(out)]).startswith(
+        "tavis eval: error: --image-size must be HxW in pixels")
+    assert _refused(["record", "--tasks", "tabletop", "--split", "ood_spatial", "--out", str(out)]) == (
+        "tavis record: error: --split of task 'tabletop' must be one of ('id',), got 'ood_spatial'")
+    assert _refused(["record", "--tasks", "no_such_task", "--out", str(out)]).startswith(
+        "tavis record: error: --tasks must be one of [")
+    assert not out.exists()
+
+
+def test_a_checkpoint_folder_without_its_config_is_one_line(tmp_path):
+    checkpoint = tmp_path / "pretrained_model"
+    checkpoint.mkdir()
+    message = _refused(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out")])
+    assert message.startswith("tavis eval: error: ") and "config.json" in message and str(checkpoint) in message

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from lerobot_tavis.errors import FieldError, InputError
+
 SPLITS = ("id", "ood_spatial", "ood_init_pose", "ood_visual")
 # ood_visual (envs/visual_ood.py) changes only the look; `ood_visual:<factor>` applies one factor alone.
 VISUAL_SPLIT = "ood_visual"
@@ -20,15 +22,15 @@ def parse_split(split: str) -> tuple[str, tuple[str, ...]]:
     another split -> (split, ()). Raises ValueError for an unknown split or factor."""
     name, _, factor = split.partition(":")
     if name not in SPLITS:
-        raise ValueError(f"split must be one of {split_names()}, got {split!r}")
+        raise FieldError("split", f"must be one of {split_names()}, got {split!r}")
     if name != VISUAL_SPLIT:
         if factor:
-            raise ValueError(f"only {VISUAL_SPLIT} takes a factor (e.g. {VISUAL_SPLIT}:lighting), got {split!r}")
+            raise InputError(f"only {VISUAL_SPLIT} takes a factor (e.g. {VISUAL_SPLIT}:lighting), got {split!r}")
         return name, ()
     if not factor:
         return name, VISUAL_FACTORS
     if factor not in VISUAL_FACTORS:
-        raise ValueError(f"the factor of {VISUAL_SPLIT} must be one of {VISUAL_FACTORS}, got {factor!r}")
+        raise InputError(f"the factor of {VISUAL_SPLIT} must be one of {VISUAL_FACTORS}, got {factor!r}")
     return name, (factor,)
 
 
@@ -113,7 +115,7 @@ def suite_tasks(suite: str) -> tuple[str, ...]:
     names = tuple(name for name, info in TASKS.items() if info.suite == suite)
     if not names:
         suites = sorted({info.suite for info in TASKS.values()})
-        raise ValueError(f"suite must be one of {suites}, got {suite!r}")
+        raise FieldError("suite", f"must be one of {suites}, got {suite!r}")
     return names
 
 
@@ -130,7 +132,7 @@ def task_info(name: str) -> TaskInfo:
     try:
         return TASKS[name]
     except KeyError:
-        raise ValueError(f"task must be one of {sorted(TASKS)}, got {name!r}") from None
+        raise FieldError("task", f"must be one of {sorted(TASKS)}, got {name!r}") from None
 
 
 def expand_tasks(spec: str) -> dict[str, list[str]]:
