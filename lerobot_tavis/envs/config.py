@@ -2,29 +2,34 @@
 
 `task` is a suite (`tavis_head`, `tavis_hands`), a task name, or a comma list of either; `create_envs` returns
 `{suite: {task_id: VectorEnv}}` with every sub-env wrapped by LeRobot's `freeze_after_episode_end`. Simulators
-are created in the worker processes on their first reset. When an episode log is configured (by default
-`episodes.jsonl` in the output directory of the running lerobot-eval / lerobot-train), each finished episode
-appends one JSON line with its seed, success and GALT.
+are created in the worker processes on their first reset. When there is an episode log, each finished episode
+appends one JSON line with its seed, success and episode metrics (GALT, wrist lead) to it.
+
+Where the log goes: `--env.episode_log=PATH` when given; else `<output_dir>/episodes.jsonl` when `--output_dir` is
+on the command line (read with LeRobot's own `lerobot.configs.parser.parse_arg`), beside lerobot-eval's
+`eval_info.json`; else nowhere, with a warning. LeRobot 0.6.1 offers the env no way to learn the run's output
+directory: `make_env` calls `create_envs(n_envs, use_async_envs)` with the env config alone, and the default
+`outputs/eval/<date>/<time>_<job>` is made later from the clock by the pipeline config.
 """
 
 from __future__ import annotations
 
-import inspect
+import logging
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 
 import gymnasium as gym
+from lerobot.configs import parser
 from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.envs.configs import EnvConfig
 from lerobot.envs.utils import _LazyAsyncVectorEnv, freeze_after_episode_end
 
 from lerobot_tavis import canonical, checks
-from lerobot_tavis.envs.factory import make_tavis_env
+from lerobot_tavis.envs.factory import EPISODE_LOG_NAME, make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split
 from lerobot_tavis.errors import FieldError
-from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 
 ROBOT_NAMES = ("gr1t2", "reachy2")
 
@@ -52,7 +57,8 @@ class TavisEnvConfig(EnvConfig):
     image_size: tuple[int, int] = (480, 640)
     # Episode length in seconds (400 steps at 20 Hz by default)
     episode_length_s: float = 20.0
-    # JSON-lines log of every finished episode (seed, success, GALT); default <output_dir>/episodes.jsonl
+    # JSON-lines log of every finished episode (seed, success, GALT); default <output_dir>/episodes.jsonl when
+    # --output_dir is on the command line, else none
     episode_log: str | None = None
     # Derived from camera_mode and image_size; not to be set
     features: dict[str, PolicyFeature] = field(default_factory=dict)
@@ -86,7 +92,7 @@ class TavisEnvConfig(EnvConfig):
                 "image_size": tuple(self.image_size), "episode_length_s": self.episode_length_s}
 
     def create_envs(self, n_envs: int, use_async_envs: bool = False) -> dict[str, dict[int, gym.vector.VectorEnv]]:
-        log = self.episode_log or _pipeline_episode_log()
+        log = self.episode_log or command_line_episode_log()
         envs: dict[str, dict[int, gym.vector.VectorEnv]] = {}
         for suite, tasks in expand_tasks(self.task).items():
             envs[suite] = {}
@@ -104,16 +110,17 @@ class TavisEnvConfig(EnvConfig):
         return envs
 
 
-def _pipeline_episode_log() -> Path | None:
-    """`<output_dir>/episodes.jsonl` of the lerobot-eval or lerobot-train run that is creating the envs.
+def command_line_episode_log(args: list[str] | None = None) -> Path | None:
+    """`<output_dir>/episodes.jsonl` for the `--output_dir` on the command line (default: sys.argv), else None.
 
-    LeRobot passes only the env config to `create_envs`, so the pipeline config (`cfg`, with its resolved
-    `output_dir`) is looked up in the calling frames.
+    LeRobot passes only the env config to `create_envs`, and no hook of 0.6.1 tells an env its run's output
+    directory; an explicit `--output_dir` is the one place it can be read. Without one, LeRobot invents a
+    timestamped directory the env cannot see, so no log is written and a warning says how to get one.
     """
-    frame = inspect.currentframe()
-    while frame is not None:
-        output_dir = getattr(frame.f_locals.get("cfg"), "output_dir", None)
-        if output_dir:
-            return Path(output_dir) / EPISODE_LOG_NAME
-        frame = frame.f_back
+    output_dir = parser.parse_arg("output_dir", args)
+    if output_dir:
+        return Path(output_dir) / EPISODE_LOG_NAME
+    logging.getLogger(__name__).warning(
+        "tavis: no episode log (no --env.episode_log and no --output_dir on the command line); `tavis report` "
+        "needs one beside eval_info.json: pass --output_dir=DIR or --env.episode_log=DIR/%s", EPISODE_LOG_NAME)
     return None

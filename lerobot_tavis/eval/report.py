@@ -1,9 +1,11 @@
-"""`tavis report <dir>`: success rates with Wilson 95% intervals and GALT, per task x split, from evaluations.
+"""`tavis report <dir>`: success rates with Wilson 95% intervals and the episode metrics, per task x split.
 
 Every `eval_info.json` under the directory (LeRobot's result of one lerobot-eval run) is joined with the
 `episodes.jsonl` next to it: per (suite, task_id), a log record belongs to episode `seed - start_seed` (the start
 seed is the smallest logged seed) and only episodes below LeRobot's `n_episodes` count, exactly the episodes
-LeRobot scored. Writes `results.json`, `results.md`, `success_rates.png` and `galt_<task>.png` into the directory,
+LeRobot scored. Every metric of `lerobot_tavis.metrics.registry` (GALT, the wrist lead) is summarised per cell from
+its `<name>_s` and `<name>_reason` fields, in registry order. Writes `results.json`, `results.md`,
+`success_rates.png` and `<metric>_<task>.png` (metrics with a histogram, e.g. `galt_<task>.png`) into the directory,
 and beside each evaluation's videos a copy with the episode's GALT events drawn on (`videos_annotated/`).
 """
 
@@ -19,6 +21,7 @@ from lerobot_tavis.atomic import atomic_path, write_text
 from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
+from lerobot_tavis.metrics.registry import episode_metrics
 from lerobot_tavis.metrics.stats import wilson_interval
 
 EVAL_INFO_NAME = "eval_info.json"
@@ -27,7 +30,7 @@ DELTA_SPLITS = ("ood_spatial", "ood_visual")  # the report gives id minus each, 
 
 @dataclass
 class LeadTimes:
-    """One cell's lead times (s, valid episodes only) and how often its detector gave each reason."""
+    """One cell's values of one metric (s, valid episodes only) and how often its detector gave each reason."""
 
     values_s: list[float] = field(default_factory=list)
     reasons: dict[str, int] = field(default_factory=dict)
@@ -52,15 +55,21 @@ def _float(value) -> float | None:
 
 @dataclass
 class Cell:
-    """One task x split: its episodes' successes, GALT and (TAVIS-Hands) wrist lead times."""
+    """One task x split: its episodes' successes and the values of every episode metric, by metric name."""
 
     task: str
     suite: str
     split: str
     successes: list[bool] = field(default_factory=list)
-    galt: LeadTimes = field(default_factory=LeadTimes)
-    wrist_lead: LeadTimes = field(default_factory=LeadTimes)
+    metrics: dict[str, LeadTimes] = field(default_factory=lambda: {m.name: LeadTimes() for m in episode_metrics()})
     unstable: int = 0  # episodes ended by a simulator instability (counted as failures)
+
+    def add(self, record: dict) -> None:
+        """One scored episode record of the episode log."""
+        self.successes.append(bool(record["success"]))
+        for metric in episode_metrics():
+            self.metrics[metric.name].add(record.get(metric.value_field), record.get(metric.reason_field))
+        self.unstable += bool(record.get("instability"))
 
     def summary(self) -> dict:
         k, n = sum(self.successes), len(self.successes)
@@ -68,7 +77,7 @@ class Cell:
         return {
             "task": self.task, "suite": self.suite, "split": self.split, "n": n, "successes": k,
             "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high, "unstable": self.unstable,
-            **self.galt.summary("galt"), **self.wrist_lead.summary("wrist_lead"),
+            **{key: value for name, times in self.metrics.items() for key, value in times.summary(name).items()},
         }
 
 
@@ -157,10 +166,7 @@ def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
         for record in episodes:
             cell = cells.setdefault((record["task"], record["split"]),
                                     Cell(record["task"], record["suite"], record["split"]))
-            cell.successes.append(bool(record["success"]))
-            cell.galt.add(record.get("galt_s"), record.get("galt_reason"))
-            cell.wrist_lead.add(record.get("wrist_lead_s"), record.get("wrist_lead_reason"))
-            cell.unstable += bool(record.get("instability"))
+            cell.add(record)
             meta.setdefault("robots", set()).add(record["robot"])
             meta.setdefault("camera_modes", set()).add(record["camera_mode"])
     for meta in sources:
@@ -215,11 +221,8 @@ def markdown(report: dict) -> str:
     avg = [_pct(a["success_rate"], a["ci_low"], a["ci_high"]) + f" ({a['n']})" for a in
            (report["average"][s] for s in splits)]
     lines += ["| **AVERAGE** (pooled) | " + " | ".join(avg + [""] * len(deltas)) + " |"]
-    lines += _lead_table(cells, tasks, splits, "galt",
-                         "GALT (gaze-action lead time, s) over successful episodes of head-camera modes.")
-    lines += _lead_table(cells, tasks, splits, "wrist_lead",
-                         "Wrist lead (s): the grasping hand's wrist camera settles before the final grasp "
-                         "(successful TAVIS-Hands episodes).")
+    for metric in episode_metrics():
+        lines += _lead_table(cells, tasks, splits, metric.name, metric.caption)
     unstable = [f"{c['task']} {c['split']}: {c['unstable']} of {c['n']}" for c in report["cells"] if c["unstable"]]
     if unstable:
         lines += ["", "Episodes ended by a simulator instability (counted as failures; the episode log names the "
@@ -228,7 +231,7 @@ def markdown(report: dict) -> str:
 
 
 def _lead_table(cells: dict, tasks: list[str], splits: list[str], prefix: str, caption: str) -> list[str]:
-    """Median, IQR, n valid and reason counts of one lead time (`galt` or `wrist_lead`) per task x split."""
+    """Median, IQR, n valid and reason counts (s) of the metric named `prefix` per task x split."""
     rows = []
     for task, split in ((t, s) for t in tasks for s in splits):
         cell = cells.get((task, split))
@@ -274,19 +277,20 @@ def plot(report: dict, out_dir: Path) -> list[Path]:
     ax.legend()
     fig.tight_layout()
     written.append(_save(fig, out_dir / "success_rates.png"))
-    for task in tasks:
-        values = {s: c["galt_values_s"] for s in splits if (c := cells.get((task, s))) is not None}
-        if not any(values.values()):
-            continue
-        fig, ax = plt.subplots(figsize=(5.0, 3.2))
-        ax.hist(list(values.values()), bins=np.arange(-0.5, 4.05, 0.1), label=list(values), stacked=True)
-        ax.set_xlabel("GALT (s)")
-        ax.set_ylabel("episodes")
-        ax.set_title(task)
-        ax.legend()
-        fig.tight_layout()
-        written.append(_save(fig, out_dir / f"galt_{task}.png"))
-        plt.close("all")
+    for metric in (m for m in episode_metrics() if m.histogram is not None):
+        for task in tasks:
+            values = {s: c[f"{metric.name}_values_s"] for s in splits if (c := cells.get((task, s))) is not None}
+            if not any(values.values()):
+                continue
+            fig, ax = plt.subplots(figsize=(5.0, 3.2))
+            ax.hist(list(values.values()), bins=metric.histogram.bins(), label=list(values), stacked=True)
+            ax.set_xlabel(metric.histogram.xlabel)
+            ax.set_ylabel("episodes")
+            ax.set_title(task)
+            ax.legend()
+            fig.tight_layout()
+            written.append(_save(fig, out_dir / f"{metric.name}_{task}.png"))
+            plt.close("all")
     return written
 
 

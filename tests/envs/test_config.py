@@ -9,6 +9,7 @@ import lerobot_env_tavis  # noqa: F401  (registers the env type, as LeRobot's CL
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.config import TavisEnvConfig, expand_tasks
 from lerobot_tavis.envs.env import scene_seed
+from lerobot_tavis.eval.episode_log import EpisodeLogger
 
 
 def test_every_registered_env_type_is_default_constructible():
@@ -81,3 +82,29 @@ def test_async_create_envs_run_in_forkserver_workers():
 def test_tasks_given_the_same_seed_get_their_own_scene():
     assert scene_seed(1000, "clutter_pick_cube") != scene_seed(1000, "blocked_clutter_pick_cube")
     assert scene_seed(1000, "clutter_pick_cube") == scene_seed(1000, "clutter_pick_cube")
+
+
+def _episode_log_of(config: TavisEnvConfig):
+    """The path the episode log of create_envs' first sub-env writes to, or None without one."""
+    vec = config.create_envs(n_envs=1)["tavis_head"][0]
+    env = vec.envs[0]
+    while not isinstance(env, EpisodeLogger) and hasattr(env, "env"):
+        env = env.env
+    vec.close()
+    return env.path if isinstance(env, EpisodeLogger) else None
+
+
+@pytest.mark.parametrize("argv", [["--output_dir=OUT"], ["--output_dir", "OUT"]])
+def test_plain_lerobot_eval_logs_beside_the_output_dir_of_its_command_line(tmp_path, monkeypatch, argv):
+    argv = [arg.replace("OUT", str(tmp_path / "run")) for arg in argv]
+    monkeypatch.setattr("sys.argv", ["lerobot-eval", "--env.type=tavis", *argv])
+    assert _episode_log_of(TavisEnvConfig(task="wait_then_act")) == tmp_path / "run" / "episodes.jsonl"
+
+
+def test_an_explicit_episode_log_wins_and_without_either_there_is_none(tmp_path, monkeypatch, caplog):
+    monkeypatch.setattr("sys.argv", ["lerobot-eval", f"--output_dir={tmp_path / 'run'}"])
+    config = TavisEnvConfig(task="wait_then_act", episode_log=str(tmp_path / "mine.jsonl"))
+    assert _episode_log_of(config) == tmp_path / "mine.jsonl"
+    monkeypatch.setattr("sys.argv", ["lerobot-eval", "--env.type=tavis"])
+    assert _episode_log_of(TavisEnvConfig(task="wait_then_act")) is None
+    assert "no episode log" in caplog.text and "--env.episode_log" in caplog.text

@@ -7,7 +7,9 @@ import numpy as np
 from lerobot.envs.utils import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd
 
 from lerobot_tavis import canonical
-from lerobot_tavis.eval.episode_log import GALT_FIELDS, WRIST_FIELDS, EpisodeLogger
+from lerobot_tavis.eval.episode_log import EpisodeLogger
+from lerobot_tavis.metrics.galt_metric import GALT
+from lerobot_tavis.metrics.wrist_lead_metric import WRIST_LEAD
 from tests.test_galt import episode, peek_then_grasp
 
 
@@ -66,7 +68,7 @@ def test_no_galt_for_failures_or_fixed_camera_modes(tmp_path):
         _run(env, 7, len(actions))
     records = [json.loads(line) for line in log.read_text().splitlines()]
     assert len(records) == 2 and [r["success"] for r in records] == [False, True]
-    assert all(r[field] is None for r in records for field in GALT_FIELDS + WRIST_FIELDS)
+    assert all(r[field] is None for r in records for field in GALT.fields + WRIST_LEAD.fields)
 
 
 def test_hands_episodes_log_the_wrist_lead_of_the_final_grasp(tmp_path):
@@ -77,3 +79,13 @@ def test_hands_episodes_log_the_wrist_lead_of_the_final_grasp(tmp_path):
     assert record["wrist_lead_reason"] == "ok" and record["wrist_lead_arm"] == "right"
     assert abs(record["wrist_lead_s"] - 1.6) < 0.1
     assert record["galt_s"] is None  # fixed camera: no GALT
+
+
+def test_the_log_writes_the_fields_of_every_metric_in_registry_order(tmp_path):
+    actions = episode(20, 3.0, 1.0, hand=(1.4, 2.0), grasp_s=2.0)
+    log = tmp_path / "episodes.jsonl"
+    info = _run(EpisodeLogger(ScriptedEnv(actions), log, "tavis_head", 0), 0, len(actions))
+    (record,) = [json.loads(line) for line in log.read_text().splitlines()]
+    assert list(record) == ["robot", "suite", "task", "task_id", "split", "camera_mode", "seed", "success",
+                            "length_steps", "prompt", *GALT.fields, *WRIST_LEAD.fields, "instability"]
+    assert all(info[field] == record[field] for field in GALT.fields + WRIST_LEAD.fields)
