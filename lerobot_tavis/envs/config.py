@@ -1,8 +1,9 @@
 """`--env.type=tavis`: the LeRobot EnvConfig of the benchmark, and the factory of its sub-envs.
 
 `task` is a suite (`tavis_head`, `tavis_hands`), a task name, or a comma list of either; `create_envs` returns
-`{suite: {task_id: VectorEnv}}` with every sub-env wrapped by LeRobot's `freeze_after_episode_end`. Simulators
-are created in the worker processes on their first reset. When there is an episode log, each finished episode
+`{suite: {task_id: VectorEnv}}` whose sub-envs freeze once their episode ends, as LeRobot's own envs do
+(`envs.vector`, whose async workers import neither torch nor LeRobot). Simulators are created in the worker
+processes on their first reset. When there is an episode log, each finished episode
 appends one JSON line with its seed, success and episode metrics (GALT, wrist lead) to it.
 
 Where the log goes: `--env.episode_log=PATH` when given; else `<output_dir>/episodes.jsonl` when `--output_dir` is
@@ -23,12 +24,12 @@ import gymnasium as gym
 from lerobot.configs import parser
 from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.envs.configs import EnvConfig
-from lerobot.envs.utils import _LazyAsyncVectorEnv, freeze_after_episode_end
 
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.factory import EPISODE_LOG_NAME, make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split
+from lerobot_tavis.envs.vector import Frozen, LazyAsyncVectorEnv
 from lerobot_tavis.errors import FieldError
 
 ROBOT_NAMES = ("gr1t2", "reachy2")
@@ -101,11 +102,11 @@ class TavisEnvConfig(EnvConfig):
                                   task_id=task_id, **self.gym_kwargs)
                 if use_async_envs and n_envs > 1:
                     probe = factory.func(task, **self.gym_kwargs)  # spaces only: builds no simulator
-                    envs[suite][task_id] = _LazyAsyncVectorEnv([factory] * n_envs, probe.observation_space,
-                                                               probe.action_space, probe.metadata)
+                    envs[suite][task_id] = LazyAsyncVectorEnv([factory] * n_envs, probe.observation_space,
+                                                              probe.action_space, probe.metadata)
                 else:
                     envs[suite][task_id] = gym.vector.SyncVectorEnv(
-                        [freeze_after_episode_end(factory)] * n_envs,
+                        [Frozen(factory)] * n_envs,
                         autoreset_mode=gym.vector.AutoresetMode.NEXT_STEP)
         return envs
 

@@ -1,6 +1,6 @@
 """One JSON line per finished episode: who, what, which seed, success, length and every episode metric.
 
-The wrapper sits inside LeRobot's `FreezeAfterEpisodeEnd`, so it sees each genuine episode once. It records the
+The wrapper sits inside `envs.vector.FreezeAfterEpisodeEnd`, so it sees each genuine episode once. It records the
 actions the env actually applied (after clipping, and with the neck zeroed in fixed-camera modes) and, when an
 episode ends, writes the fields of every metric of `lerobot_tavis.metrics.registry`, in its order, computed from
 them at the env's rate (20 Hz in evaluation): GALT for successful episodes of head-camera modes, as the reference

@@ -1,14 +1,18 @@
 """`--env.type=tavis` as LeRobot uses it: registry, features, create_envs (sync and forkserver async), seeds."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
+from lerobot.envs import utils as lerobot_env_utils
 from lerobot.envs.configs import EnvConfig
-from lerobot.envs.utils import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd, _LazyAsyncVectorEnv, preprocess_observation
+from lerobot.envs.utils import preprocess_observation
 
 import lerobot_env_tavis  # noqa: F401  (registers the env type, as LeRobot's CLIs do)
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.config import TavisEnvConfig, expand_tasks
 from lerobot_tavis.envs.env import scene_seed
+from lerobot_tavis.envs.vector import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd, LazyAsyncVectorEnv
 from lerobot_tavis.eval.episode_log import EpisodeLogger
 
 
@@ -71,12 +75,19 @@ def test_sync_create_envs_wraps_every_sub_env_and_runs():
 def test_async_create_envs_run_in_forkserver_workers():
     config = TavisEnvConfig(task="wait_then_act", image_size=(24, 32))
     vec = config.create_envs(n_envs=2, use_async_envs=True)["tavis_head"][0]
-    assert isinstance(vec, _LazyAsyncVectorEnv)
+    assert isinstance(vec, LazyAsyncVectorEnv)
     obs, _ = vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
     assert obs["pixels"]["head"].shape == (2, 24, 32, 3)
     obs, reward, terminated, truncated, info = vec.step(np.tile(canonical.rest_action(), (2, 1)))
     assert obs["agent_pos"].shape == (2, 19)
+    workers = [process.pid for process in vec._started().processes]
+    mapped = [Path(f"/proc/{pid}/maps").read_text() for pid in workers]
     vec.close()
+    assert len(mapped) == 2 and not any("libtorch" in maps or "/lerobot/" in maps for maps in mapped)
+
+
+def test_the_new_rollout_option_is_lerobots():
+    assert NEW_ROLLOUT_OPTION == lerobot_env_utils.NEW_ROLLOUT_OPTION
 
 
 def test_tasks_given_the_same_seed_get_their_own_scene():

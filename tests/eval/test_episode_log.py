@@ -4,9 +4,9 @@ import json
 
 import gymnasium as gym
 import numpy as np
-from lerobot.envs.utils import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd
 
 from lerobot_tavis import canonical
+from lerobot_tavis.envs.vector import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd
 from lerobot_tavis.eval.episode_log import EpisodeLogger
 from lerobot_tavis.metrics.galt_metric import GALT
 from lerobot_tavis.metrics.wrist_lead_metric import WRIST_LEAD

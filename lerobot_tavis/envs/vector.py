@@ -1,0 +1,96 @@
+"""Vector envs for `--env.type=tavis` whose worker processes stay lean: they import neither torch nor LeRobot.
+
+LeRobot's own lazy async vector env wraps every sub-env factory in a closure of `lerobot.envs.utils`, so each
+worker that unpickles one imports that module, and with it torch: 0.7-0.9 GB resident per worker instead of about
+0.3 (measured: a `tavis eval --policy` job's env workers), enough to exhaust a 128 GB machine with 8 jobs of 12
+envs. This module gives the same two behaviours from classes that import only gymnasium:
+
+- `FreezeAfterEpisodeEnd`: once a sub-env's episode has ended, further steps and Gymnasium's autoresets replay its
+  terminal transition (reward 0) instead of simulating, until an explicit reset carrying LeRobot's new-rollout
+  option (`NEW_ROLLOUT_OPTION`, the key lerobot-eval's rollout passes) starts the next episode.
+- `LazyAsyncVectorEnv`: the AsyncVectorEnv (forkserver workers, shared memory, next-step autoreset) is created on
+  first use, so one task's workers are alive at a time while lerobot-eval walks a suite.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import gymnasium as gym
+
+NEW_ROLLOUT_OPTION = "lerobot_new_rollout"  # lerobot.envs.utils.NEW_ROLLOUT_OPTION (a test keeps them equal)
+
+
+class FreezeAfterEpisodeEnd(gym.Wrapper):
+    """A sub-env that costs nothing between the end of its episode and the next rollout's reset."""
+
+    def __init__(self, env: gym.Env):
+        super().__init__(env)
+        self._terminal: tuple | None = None
+
+    def reset(self, *, seed=None, options=None):
+        if self._terminal is not None and not (options or {}).get(NEW_ROLLOUT_OPTION):
+            observation, _, _, _, info = self._terminal  # an autoreset of an episode the rollout is done with
+            return observation, info
+        self._terminal = None
+        return self.env.reset(seed=seed, options=options)
+
+    def step(self, action):
+        if self._terminal is not None:
+            return self._terminal
+        observation, reward, terminated, truncated, info = self.env.step(action)
+        if terminated or truncated:
+            self._terminal = (observation, 0.0, terminated, truncated, info)
+        return observation, reward, terminated, truncated, info
+
+
+@dataclass(frozen=True)
+class Frozen:
+    """A sub-env factory whose env freezes after its episode (picklable by reference to this module)."""
+
+    make: Callable[[], gym.Env]
+
+    def __call__(self) -> gym.Env:
+        return FreezeAfterEpisodeEnd(self.make())
+
+
+class LazyAsyncVectorEnv:
+    """An AsyncVectorEnv of `Frozen(factory)` sub-envs, started on the first reset, step, call or attribute read.
+    `observation_space`, `action_space` and `metadata` are those of one sub-env, given up front."""
+
+    def __init__(self, factories: list[Callable[[], gym.Env]], observation_space: gym.Space,
+                 action_space: gym.Space, metadata: dict):
+        self._factories = [Frozen(factory) for factory in factories]
+        self._env: gym.vector.AsyncVectorEnv | None = None
+        self.num_envs = len(factories)
+        self.observation_space = self.single_observation_space = observation_space
+        self.action_space = self.single_action_space = action_space
+        self.metadata = metadata
+
+    @property
+    def unwrapped(self) -> LazyAsyncVectorEnv:
+        return self
+
+    def _started(self) -> gym.vector.AsyncVectorEnv:
+        if self._env is None:
+            self._env = gym.vector.AsyncVectorEnv(self._factories, context="forkserver", shared_memory=True,
+                                                  autoreset_mode=gym.vector.AutoresetMode.NEXT_STEP)
+        return self._env
+
+    def reset(self, **kwargs):
+        return self._started().reset(**kwargs)
+
+    def step(self, actions):
+        return self._started().step(actions)
+
+    def call(self, name: str, *args, **kwargs):
+        return self._started().call(name, *args, **kwargs)
+
+    def get_attr(self, name: str):
+        return self._started().get_attr(name)
+
+    def close(self) -> None:
+        if self._env is not None:
+            self._env.close()
+            self._env = None
