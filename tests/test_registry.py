@@ -156,6 +156,14 @@ def test_registered_names_reach_the_config_the_cli_and_suite_expansion(toys):
     assert (view.task, view.robot) == ("toy_lift_cube", "toy_gr1t2")
 
 
+def test_a_registered_camera_mode_gets_a_preset_config_but_no_shipped_file(toys):
+    from lerobot_tavis.policy_configs import build_preset, preset_names
+
+    assert not any(TOY_MODE in name for name in preset_names())  # `tavis presets` lists files that exist
+    inputs = build_preset("diffusion", TOY_MODE)["policy"]["input_features"]
+    assert sorted(inputs) == ["observation.images.fixed", "observation.images.left_wrist", "observation.state"]
+
+
 def test_the_toys_are_gone_after_the_fixture():
     assert "toy_lift_cube" not in registry.task_names() and "toy_suite" not in registry.suite_names()
     assert "toy_gr1t2" not in registry.robot_names() and TOY_MODE not in registry.camera_mode_names()
