@@ -97,9 +97,11 @@ def _run(python: str, steps: int, *one: str) -> dict | None:
 
 
 def main() -> None:
+    from lerobot_tavis.envs.robots import BUILTIN_ROBOTS
+
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--steps", type=int, default=200)
-    parser.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"])
+    parser.add_argument("--robots", nargs="+", default=list(BUILTIN_ROBOTS))
     parser.add_argument("--shadows", action="store_true", help="also measure with shadows on")
     parser.add_argument("--repeats", type=int, default=1, help="round-robin rounds; medians are reported")
     parser.add_argument("--peer-python", default=sys.executable, help="interpreter in which gym_aloha imports")

@@ -45,12 +45,13 @@ def run_chunk(args: tuple[str, str, str, range]) -> tuple[str, str, str, int, in
 
 
 def main() -> None:
+    from lerobot_tavis.envs.robots import BUILTIN_ROBOTS
     from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
     from lerobot_tavis.metrics.stats import wilson_interval
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--episodes", type=int, default=96)
-    parser.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"])
+    parser.add_argument("--robots", nargs="+", default=list(BUILTIN_ROBOTS))
     parser.add_argument("--splits", nargs="+", default=["id", "ood_spatial"])
     parser.add_argument("--tasks", nargs="+", default=list(BENCHMARK_TASKS))
     parser.add_argument("--workers", type=int, default=os.cpu_count())

@@ -44,13 +44,14 @@ def visible_pixels(task: str, robot: str, split: str, seeds: range) -> list[int]
 
 
 def main() -> None:
+    from lerobot_tavis.envs.robots import BUILTIN_ROBOTS
     from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--split", default="id")
     parser.add_argument("--min-pixels", type=int, default=20)
-    parser.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"])
+    parser.add_argument("--robots", nargs="+", default=list(BUILTIN_ROBOTS))
     args = parser.parse_args()
     print(f"| task | {' | '.join(f'{r}: target visible (median pixels)' for r in args.robots)} |")
     print(f"|---|{'---|' * len(args.robots)}")

@@ -11,8 +11,9 @@ from pathlib import Path
 
 from lerobot_tavis.dataset_tools.features import STORAGES
 from lerobot_tavis.dataset_tools.workers import BACKENDS
-from lerobot_tavis.envs.modes import CAMERA_MODES, CAMERA_NAMES, DEFAULT_CAMERA_MODE, RENAMED_MODES, VIEW_CAMERAS
-from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, PROTOCOL_SPLITS, split_names
+from lerobot_tavis.envs.modes import CAMERA_NAMES, DEFAULT_CAMERA_MODE, RENAMED_MODES, VIEW_CAMERAS, camera_mode_names
+from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, PROTOCOL_SPLITS, SUITES, split_names, task_names
 from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError
 
 
@@ -34,7 +35,7 @@ def _gallery(args: argparse.Namespace) -> None:
 
 
 # `tavis eval` settings when neither the command line nor the checkpoint's training config gives them.
-EVAL_DEFAULTS = {"robot": "gr1t2", "camera_mode": DEFAULT_CAMERA_MODE, "image_size": (480, 640)}
+EVAL_DEFAULTS = {"robot": DEFAULT_ROBOT, "camera_mode": DEFAULT_CAMERA_MODE, "image_size": (480, 640)}
 
 
 def _eval(args: argparse.Namespace) -> None:
@@ -205,7 +206,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True)
     demo = commands.add_parser("demo", help="one demonstrator episode per task and robot: MP4 of the four views")
     demo.add_argument("--out", default="outputs/demo", help="output directory (default: outputs/demo)")
-    demo.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"], choices=["gr1t2", "reachy2"])
+    demo.add_argument("--robots", nargs="+", default=list(robot_names()), choices=robot_names())
     demo.add_argument("--tasks", nargs="+", help="task names (default: the eight TAVIS tasks)")
     demo.add_argument("--image-size", default="240x320", help="HxW of every camera (default 240x320)")
     demo.add_argument("--seed", type=int, default=0)
@@ -214,7 +215,7 @@ def build_parser() -> argparse.ArgumentParser:
     gallery = commands.add_parser("gallery", help="stills of every task and robot (first observation, grasp) and "
                                   "the README overview figure")
     gallery.add_argument("--out", default="docs/images", help="output directory (default: docs/images)")
-    gallery.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"], choices=["gr1t2", "reachy2"])
+    gallery.add_argument("--robots", nargs="+", default=list(robot_names()), choices=robot_names())
     gallery.add_argument("--tasks", nargs="+", choices=BENCHMARK_TASKS, help="default: the eight TAVIS tasks")
     gallery.add_argument("--image-size", default="240x320", help="HxW of every view (default 240x320)")
     gallery.add_argument("--seed", type=int, default=0, help="episode seed of every task (default 0)")
@@ -223,13 +224,13 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate = commands.add_parser("eval", help="the 96-episode protocol for a policy checkpoint or the demonstrators")
     evaluate.add_argument("--policy", help="policy checkpoint directory (pretrained_model)")
     evaluate.add_argument("--expert", action="store_true", help="evaluate the scripted demonstrators instead")
-    evaluate.add_argument("--robot", choices=["gr1t2", "reachy2"], help="default: the checkpoint's, else gr1t2")
-    evaluate.add_argument("--suite", nargs="+", default=["tavis_head"], choices=["tavis_head", "tavis_hands"])
+    evaluate.add_argument("--robot", choices=robot_names(), help=f"default: the checkpoint's, else {DEFAULT_ROBOT}")
+    evaluate.add_argument("--suite", nargs="+", default=[SUITES[0]], choices=SUITES)
     evaluate.add_argument("--splits", nargs="+", default=list(PROTOCOL_SPLITS), choices=split_names(),
                           help="default: the reference's id ood_spatial ood_init_pose; also ood_visual (the look "
                           "changed) and ood_visual:<factor> for one factor alone")
     evaluate.add_argument("--episodes", type=int, default=96, help="episodes per task and split (default 96)")
-    evaluate.add_argument("--camera-mode", choices=[*CAMERA_MODES, *RENAMED_MODES],
+    evaluate.add_argument("--camera-mode", choices=[*camera_mode_names(), *RENAMED_MODES],
                           help="default: the checkpoint's, else head_wrist; head_wrist and fixed_wrist are the "
                           "paper's headcam and fixedcam conditions")
     evaluate.add_argument("--image-size", help="HxW; default: the checkpoint's, else 480x640")
@@ -251,8 +252,8 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.set_defaults(run=_eval, options={"n_episodes": "--episodes"})
 
     rec = commands.add_parser("record", help="record scripted demonstrations at 60 Hz (replayable raw episodes)")
-    rec.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
-    rec.add_argument("--suite", default="tavis_head", choices=["tavis_head", "tavis_hands"])
+    rec.add_argument("--robot", default=DEFAULT_ROBOT, choices=robot_names())
+    rec.add_argument("--suite", default=SUITES[0], choices=SUITES)
     rec.add_argument("--tasks", nargs="+", help="task names (default: every task of --suite)")
     rec.add_argument("--split", default="id", choices=split_names())
     rec.add_argument("--episodes-per-task", type=int, default=160, help="kept episodes per task (default 160)")
@@ -265,8 +266,8 @@ def build_parser() -> argparse.ArgumentParser:
     rec.set_defaults(run=_record, options={"task": "--tasks"})
 
     tele = commands.add_parser("teleop", help="drive the robot with the keyboard and record raw episodes (a window)")
-    tele.add_argument("--task", required=True, choices=BENCHMARK_TASKS)
-    tele.add_argument("--robot", default="gr1t2", choices=["gr1t2", "reachy2"])
+    tele.add_argument("--task", required=True, choices=task_names())
+    tele.add_argument("--robot", default=DEFAULT_ROBOT, choices=robot_names())
     tele.add_argument("--split", default="id", choices=split_names())
     tele.add_argument("--episodes", type=int, default=1, help="kept episodes to record (default 1)")
     tele.add_argument("--seed-start", type=int, default=200_000, help="first seed (default 200000)")
@@ -279,8 +280,8 @@ def build_parser() -> argparse.ArgumentParser:
     tele.set_defaults(run=_teleop)
 
     view = commands.add_parser("view", help="MuJoCo's interactive viewer on one episode (a window)")
-    view.add_argument("--task", required=True, choices=BENCHMARK_TASKS)
-    view.add_argument("--robot", choices=["gr1t2", "reachy2"], help="default: the checkpoint's, else gr1t2")
+    view.add_argument("--task", required=True, choices=task_names())
+    view.add_argument("--robot", choices=robot_names(), help=f"default: the checkpoint's, else {DEFAULT_ROBOT}")
     view.add_argument("--split", default="id", choices=split_names())
     view.add_argument("--seed", type=int, default=1000)
     view.add_argument("--driver", choices=["demonstrator", "policy", "paused"],

@@ -15,6 +15,7 @@ from tqdm import tqdm
 from lerobot_tavis import checks
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_NAMES
+from lerobot_tavis.envs.robots import robot_names
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
 from lerobot_tavis.experts.registry import make_expert
 from lerobot_tavis.media import write_mp4
@@ -48,9 +49,10 @@ def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) 
     return frames, success
 
 
-def run_demo(out_dir: str | Path, robots=("gr1t2", "reachy2"), tasks=TASKS, image_size=(240, 320),
-             seed: int = 0) -> list[Path]:
+def run_demo(out_dir: str | Path, robots=None, tasks=TASKS, image_size=(240, 320), seed: int = 0) -> list[Path]:
+    """Film every task of `tasks` on every robot of `robots` (default: every registered robot)."""
     checks.integer("seed", seed, 0)
+    robots = robot_names() if robots is None else robots
     out_dir = Path(out_dir)
     written = []
     for robot in robots:

@@ -23,18 +23,17 @@ from tqdm import tqdm
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.rendering import CameraRig
+from lerobot_tavis.envs.robots import BUILTIN_ROBOTS, DEFAULT_ROBOT, robot_info, robot_names
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, VISUAL_FACTORS, VISUAL_SPLIT, task_info
 from lerobot_tavis.experts.registry import make_expert
 from lerobot_tavis.media import label, write_png
 
-ROBOTS = ("gr1t2", "reachy2")
 GRASP_DELAY_STEPS = 8  # 0.4 s after the close command: the fingers have met the object
 SHEET_VIEWS = ("head", "fixed", "wrist", "overview")  # "wrist": the wrist camera of the arm that grasps
 OOD_VISUAL_TASK, OOD_VISUAL_VIEWS = "conditional_pick", ("head", "fixed", "overview")
 CAPTION_PX, CAPTION_SCALE = 26, 0.5
 TILE_PAD, PANEL_PAD = 3, 6
 HEAD_TINT, HANDS_TINT, ROBOTS_TINT = (190, 215, 235), (190, 230, 215), (245, 215, 190)
-ROBOT_TITLES = {"gr1t2": "GR1T2", "reachy2": "Reachy2"}
 PORTRAIT_LOOKAT = (0.05, 0.0, 1.22)  # world point (m) the robot portraits are centred on
 PORTRAIT_DISTANCE_M = 1.9
 BACKGROUND = (255, 255, 255)
@@ -129,8 +128,9 @@ def overview_figure(stills: dict[str, Stills], portraits: dict[str, np.ndarray])
     hands = [t for t in BENCHMARK_TASKS if task_info(t).suite == "tavis_hands"]
     hands_grid = _grid({t: stills[t].grasp for t in hands}, ("head", "overview"), ("head cam", "external view"))
     hands_panel = _panel("TAVIS-Hands (local occlusion and peeking)", HANDS_TINT, hands_grid)
-    robots = _stack_horizontal([_stack_vertical([_caption(ROBOT_TITLES[name], image.shape[1]), _pad(image, TILE_PAD)])
-                                for name, image in portraits.items()])
+    robots = _stack_horizontal([
+        _stack_vertical([_caption(robot_info(name).title, image.shape[1]), _pad(image, TILE_PAD)])
+        for name, image in portraits.items()])
     robots_panel = _panel("Robots", ROBOTS_TINT,
                           _fit_height(robots, hands_panel.shape[0] - 2 * PANEL_PAD - CAPTION_PX))
     return _stack_vertical([
@@ -140,10 +140,12 @@ def overview_figure(stills: dict[str, Stills], portraits: dict[str, np.ndarray])
     ])
 
 
-def write_gallery(out_dir: str | Path, *, robots=ROBOTS, tasks=BENCHMARK_TASKS, image_size=(240, 320),
-                  seed: int = 0, figure_robot: str = "gr1t2") -> list[Path]:
-    """Render every task sheet and, when all eight tasks of `figure_robot` are included, the overview figure."""
+def write_gallery(out_dir: str | Path, *, robots=None, tasks=BENCHMARK_TASKS, image_size=(240, 320),
+                  seed: int = 0, figure_robot: str = DEFAULT_ROBOT) -> list[Path]:
+    """Render every task sheet (`robots`: default every registered robot) and, when all eight tasks of
+    `figure_robot` are included, the overview figure."""
     checks.integer("seed", seed, 0)
+    robots = robot_names() if robots is None else robots
     out_dir = Path(out_dir)
     written, by_robot = [], {}
     jobs = [(robot, task) for robot in robots for task in tasks]
@@ -155,7 +157,7 @@ def write_gallery(out_dir: str | Path, *, robots=ROBOTS, tasks=BENCHMARK_TASKS, 
         sheet = ood_visual_sheet(OOD_VISUAL_TASK, robot, image_size=image_size, seed=seed)
         written.append(write_png(out_dir / "gallery" / robot / "ood_visual.png", sheet))
     if figure_robot in by_robot and set(by_robot[figure_robot]) == set(BENCHMARK_TASKS):
-        portraits = {robot: robot_portrait(robot) for robot in ROBOTS}
+        portraits = {robot: robot_portrait(robot) for robot in BUILTIN_ROBOTS}  # the benchmark's robots
         written.append(write_png(out_dir / "overview.png", overview_figure(by_robot[figure_robot], portraits)))
     return written
 

@@ -5,7 +5,9 @@ os.environ.setdefault("MUJOCO_GL", "egl")  # before anything imports mujoco
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-ROBOTS = ("gr1t2", "reachy2")
+from lerobot_tavis.envs.robots import BUILTIN_ROBOTS  # noqa: E402
+
+ROBOTS = BUILTIN_ROBOTS
 
 
 @pytest.fixture(params=ROBOTS)

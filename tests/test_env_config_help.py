@@ -5,8 +5,9 @@ import subprocess
 import sys
 from dataclasses import fields
 
-from lerobot_tavis.envs.config import ROBOT_NAMES, TavisEnvConfig
+from lerobot_tavis.envs.config import TavisEnvConfig
 from lerobot_tavis.envs.modes import CAMERA_MODES
+from lerobot_tavis.envs.robots import ROBOTS
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SPLITS, SUITES
 
 
@@ -22,7 +23,7 @@ def test_every_field_has_help_naming_its_allowed_values():
     assert set(entries) == {f.name for f in fields(TavisEnvConfig) if f.name != "type"}
     for name, help_text in entries.items():
         assert "(default:" in help_text, f"--env.{name} has no help: {help_text!r}"
-    for name, values in (("task", (*SUITES, *BENCHMARK_TASKS)), ("robot", ROBOT_NAMES), ("camera_mode", CAMERA_MODES),
+    for name, values in (("task", (*SUITES, *BENCHMARK_TASKS)), ("robot", ROBOTS), ("camera_mode", CAMERA_MODES),
                          ("split", SPLITS)):
         missing = [v for v in values if v not in entries[name]]
         assert not missing, f"--env.{name} help does not name {missing}"

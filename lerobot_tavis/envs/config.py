@@ -28,11 +28,10 @@ from lerobot.envs.configs import EnvConfig
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.factory import EPISODE_LOG_NAME, make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
+from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_info
 from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split
 from lerobot_tavis.envs.vector import Frozen, LazyAsyncVectorEnv
 from lerobot_tavis.errors import FieldError
-
-ROBOT_NAMES = ("gr1t2", "reachy2")
 
 
 @EnvConfig.register_subclass("tavis")
@@ -46,7 +45,7 @@ class TavisEnvConfig(EnvConfig):
     # Policy steps per second; fixed by the benchmark at 20
     fps: int = 20
     # Robot: gr1t2 or reachy2
-    robot: str = "gr1t2"
+    robot: str = DEFAULT_ROBOT
     # Cameras the policy sees: head_wrist (the paper's "headcam": head and both wrists), fixed_wrist (its
     # "fixedcam": fixed workspace camera and both wrists), head_only, fixed_only
     camera_mode: str = DEFAULT_CAMERA_MODE
@@ -72,8 +71,7 @@ class TavisEnvConfig(EnvConfig):
 
     def __post_init__(self):
         expand_tasks(self.task)  # raises a clear error for an unknown task or suite
-        if self.robot not in ROBOT_NAMES:
-            raise FieldError("robot", f"must be one of {ROBOT_NAMES}, got {self.robot!r}")
+        robot_info(self.robot)  # raises a clear error for an unknown robot
         self.camera_mode = resolve_camera_mode(self.camera_mode)
         parse_split(self.split)  # raises a clear error for an unknown split or ood_visual factor
         if self.fps != 20:

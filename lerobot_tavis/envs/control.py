@@ -15,7 +15,7 @@ import numpy as np
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.physics import CONTROL_HZ
-from lerobot_tavis.envs.robots import Robot
+from lerobot_tavis.envs.robots.base import Robot
 from lerobot_tavis.envs.transforms import quat_angle_rad
 from lerobot_tavis.envs.world import World
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from lerobot_tavis.envs import physics, scene, visual_ood
 from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS
-from lerobot_tavis.envs.robots import Robot
+from lerobot_tavis.envs.robots.base import Robot
 from lerobot_tavis.envs.tasks.base import Task
 
 

@@ -1,4 +1,4 @@
-"""One demonstrator per task, and a helper that plays an episode."""
+"""The demonstrator of a task (declared in `envs.tasks.catalog`), and a helper that plays an episode."""
 
 from __future__ import annotations
 
@@ -7,29 +7,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lerobot_tavis.envs.tasks.catalog import TASKS, demonstrator_class
 from lerobot_tavis.errors import InputError
 from lerobot_tavis.experts.base import Expert
-from lerobot_tavis.experts.hands_tasks import BlockedClutterExpert, OccludedReachExpert, PeekingBoxExpert
-from lerobot_tavis.experts.head_tasks import ClutterExpert, ConditionalPickExpert, ShelfExpert, WaitThenActExpert
-
-EXPERTS: dict[str, type[Expert]] = {
-    "conditional_pick": ConditionalPickExpert,
-    "wait_then_act": WaitThenActExpert,
-    "clutter_pick_cube": ClutterExpert,
-    "clutter_pick_lift": ClutterExpert,
-    "multi_shelf_scan": ShelfExpert,
-    "peeking_box": PeekingBoxExpert,
-    "occluded_reach": OccludedReachExpert,
-    "blocked_clutter_pick_cube": BlockedClutterExpert,
-}
 
 
 def make_expert(env, seed: int) -> Expert:
-    """The demonstrator of `env.task`, with its own generator (timing and path variation) derived from `seed`."""
-    try:
-        cls = EXPERTS[env.task]
-    except KeyError:
-        raise InputError(f"no demonstrator for task {env.task!r}; tasks with one: {sorted(EXPERTS)}") from None
+    """The demonstrator of `env.task` (named in the task catalog), with its own generator (timing and path
+    variation) derived from `seed`."""
+    cls = demonstrator_class(env.task)
+    if cls is None:
+        with_one = sorted(name for name, info in TASKS.items() if info.demonstrator is not None)
+        raise InputError(f"no demonstrator for task {env.task!r}; tasks with one: {with_one}")
     return cls(env, np.random.default_rng([seed, 0x7A715]))
 
 

@@ -29,7 +29,8 @@ import json
 from pathlib import Path
 
 from lerobot_tavis import canonical
-from lerobot_tavis.envs.modes import CAMERA_MODES, RENAMED_MODES, mode_cameras, neck_locked, resolve_camera_mode
+from lerobot_tavis.envs.modes import (BUILTIN_CAMERA_MODES, RENAMED_MODES, mode_cameras, neck_locked,
+                                      resolve_camera_mode)
 from lerobot_tavis.errors import InputError
 
 PRESET_DIR = Path(__file__).parent
@@ -45,8 +46,9 @@ COMPACT_CHUNK, COMPACT_EXECUTED = 20, 10
 
 
 def presets() -> dict[str, tuple[str, str, bool]]:
-    """Every preset's name -> (policy, camera mode, compact)."""
-    table = {f"{policy}_{mode}": (policy, mode, False) for policy in POLICIES for mode in CAMERA_MODES}
+    """Every shipped preset's name -> (policy, camera mode, compact); registered camera modes have none (their
+    presets come from `build_preset`)."""
+    table = {f"{policy}_{mode}": (policy, mode, False) for policy in POLICIES for mode in BUILTIN_CAMERA_MODES}
     return table | {f"act_{mode}_compact": ("act", mode, True) for mode in COMPACT_MODES}
 
 

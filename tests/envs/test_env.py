@@ -8,6 +8,7 @@ from gymnasium.utils.env_checker import check_env
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.env import TavisEnv
+from lerobot_tavis.envs.modes import CAMERA_MODES
 from lerobot_tavis.overlay import Caption, compose
 from tests.conftest import run_steps
 
@@ -166,7 +167,7 @@ def test_cameras_override_the_mode_and_none_renders_nothing(small_env):
 
 
 def test_the_overview_camera_is_for_people_only(small_env):
-    for camera_mode in ("head_only", "fixed_only", "head_wrist", "fixed_wrist"):
+    for camera_mode in CAMERA_MODES:
         assert "overview" not in small_env(camera_mode=camera_mode).camera_names
     env = small_env(cameras=("overview", "head"))
     obs, _ = env.reset(seed=0)

@@ -8,9 +8,9 @@ import pytest
 
 from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.assets import ASSET_DIR
-from lerobot_tavis.envs.robots import make_robot
+from lerobot_tavis.envs.robots import BUILTIN_ROBOTS, make_robot
 
-ROBOTS = ("gr1t2", "reachy2")
+ROBOTS = BUILTIN_ROBOTS
 MESH = mujoco.mjtGeom.mjGEOM_MESH
 PHYSICS_FIELDS = ("body_mass", "body_inertia", "body_pos", "body_quat", "body_ipos", "body_iquat", "jnt_range",
                   "jnt_axis", "dof_armature", "dof_damping", "actuator_gainprm", "actuator_biasprm",

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from lerobot_tavis import canonical
-from lerobot_tavis.envs.robots import make_robot
+from lerobot_tavis.envs.robots import BUILTIN_ROBOTS, make_robot
 from lerobot_tavis.envs.transforms import quat_angle_rad
 
 
@@ -46,7 +46,7 @@ def test_reachy2_zero_pose_anchors():
     np.testing.assert_allclose(data.xanchor[model.joint("neck_pitch").id], (-0.01, 0.0, 1.111), atol=1e-3)
 
 
-@pytest.mark.parametrize("name", ["gr1t2", "reachy2"])
+@pytest.mark.parametrize("name", BUILTIN_ROBOTS)
 def test_cameras_have_the_reference_fields_of_view(name):
     robot, model, _ = _compiled(name)
 
@@ -67,7 +67,7 @@ def test_gripper_stroke(name, stroke):
             assert model.jnt_range[model.joint(f"{side}_finger_{finger}").id][1] == pytest.approx(stroke / 2)
 
 
-@pytest.mark.parametrize("name", ["gr1t2", "reachy2"])
+@pytest.mark.parametrize("name", BUILTIN_ROBOTS)
 def test_rest_calibration_holds_the_rest_pose_exactly(name):
     robot, model, data = _compiled(name)
     calibration = robot.calibration()

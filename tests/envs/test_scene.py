@@ -14,8 +14,9 @@ from lerobot_tavis.envs.assets import ASSET_DIR
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.robots import make_robot
 from lerobot_tavis.envs.tasks import multi_shelf_scan
+from lerobot_tavis.envs.tasks.catalog import BUILTIN_TASKS, task_class
 from lerobot_tavis.envs.tasks.conditional_pick import CARD
-from lerobot_tavis.envs.tasks.registry import TASK_CLASSES, make_task
+from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.tasks.wait_then_act import LIGHT
 from lerobot_tavis.envs.world import build_world
 
@@ -49,13 +50,13 @@ def _top_down(model, data, lookat, distance_m: float, size: int = 48) -> np.ndar
         return renderer.render().astype(float)
 
 
-@pytest.mark.parametrize("task_name", sorted(TASK_CLASSES))
+@pytest.mark.parametrize("task_name", sorted(BUILTIN_TASKS))
 def test_every_task_compiles_with_textured_floor_and_key_light(task_name):
     model = _model(task_name)
     floor_texture = _texture_of(model, "floor/tiles")
     assert floor_texture >= 0
     assert model.light(scene.KEY_LIGHT).type == mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
-    if TASK_CLASSES[task_name].has_table:
+    if task_class(task_name).has_table:
         for geom in ("table/top", "table/surface"):
             assert _texture_of(model, geom) >= 0
 

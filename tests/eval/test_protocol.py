@@ -9,6 +9,7 @@ import pytest
 
 from lerobot_tavis.cli import main
 from lerobot_tavis.eval import protocol
+from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
 
 
@@ -22,8 +23,7 @@ def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
     assert [t["task_id"] for t in info["per_task"]] == [0, 1, 2]
     records = [json.loads(line) for line in (cell / "episodes.jsonl").read_text().splitlines()]
     assert sorted((r["task"], r["seed"]) for r in records) == sorted(
-        (task, seed) for task in ("peeking_box", "occluded_reach", "blocked_clutter_pick_cube")
-        for seed in (1000, 1001))
+        (task, seed) for task in suite_tasks("tavis_hands") for seed in (1000, 1001))
     results = json.loads((tmp_path / "results.json").read_text())
     assert sum(c["n"] for c in results["cells"]) == 6
     before = (cell / "eval_info.json").stat().st_mtime_ns
@@ -61,7 +61,7 @@ def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     run_protocol(cfg)
     log, info = _cell_files(tmp_path)
     records = [json.loads(line) for line in log.splitlines()]
-    assert [r["task"] for r in records] == ["peeking_box", "occluded_reach", "blocked_clutter_pick_cube"]
+    assert [r["task"] for r in records] == list(suite_tasks("tavis_hands"))
     assert records[0]["prompt"] == "stored" and info["per_task"][0]["metrics"]["successes"] == [False]
     assert records[1]["prompt"] != "stored" and not work.exists()
 
@@ -149,8 +149,7 @@ def test_policy_protocol_runs_through_lerobot_eval(tmp_path):
     run_protocol(cfg)
     results = json.loads((tmp_path / "eval" / "results.json").read_text())
     assert [(c["task"], c["split"], c["n"]) for c in results["cells"]] == [
-        (task, "ood_init_pose", 1) for task in ("conditional_pick", "wait_then_act", "clutter_pick_cube",
-                                                 "clutter_pick_lift", "multi_shelf_scan")]
+        (task, "ood_init_pose", 1) for task in suite_tasks("tavis_head")]
 
 
 def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first_videos(tmp_path):

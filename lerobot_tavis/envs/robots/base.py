@@ -24,6 +24,7 @@ class Robot(abc.ABC):
     """A fixed-base humanoid torso with two 7-DoF arms, a 3-DoF neck, two parallel grippers and three cameras."""
 
     name: ClassVar[str]
+    visual_assets: ClassVar[str | None] = None  # `assets/<group>/visuals.json` to dress it in; None: primitives only
     canonical_origin: ClassVar[tuple[float, float, float]]  # world position of the canonical (hip) frame
     rest_posture_seed: ClassVar[dict[str, tuple[float, ...]]]  # seeds the rest calibration (calibration.py)
     gripper: ClassVar[GripperGeometry]
@@ -57,14 +58,14 @@ class Robot(abc.ABC):
     def build_spec(self, *, dressed: bool = False) -> mujoco.MjSpec:
         """The robot with calibrated end-effector frames: the rest quaternion is the relaxed rest orientation.
 
-        `dressed` draws the robot with its real visual meshes (`visuals.dress`) instead of its primitives; the
-        physics is the same either way, so the IK controller compiles the cheaper undressed model.
+        `dressed` draws the robot with its real visual meshes (`visuals.dress`, from `visual_assets`) instead of its
+        primitives; the physics is the same either way, so the IK controller compiles the cheaper undressed model.
         """
         spec = self.raw_spec()
         for side, quat in self.calibration().ee_quat_in_hand.items():
             spec.site(self.ee_site(side)).quat = quat
-        if dressed:
-            visuals.dress(spec, self.name)
+        if dressed and self.visual_assets:
+            visuals.dress(spec, self.visual_assets)
         return spec
 
     def calibration(self) -> RestCalibration:

@@ -42,6 +42,7 @@ def _mirror(lo: float, hi: float, sign: float) -> tuple[float, float]:
 
 class GR1T2(Robot):
     name = "gr1t2"
+    visual_assets = "gr1t2"
     canonical_origin = (0.0, 0.0, PELVIS_HEIGHT_M)
     rest_posture_seed = {  # the reference's rest joints (§3.2); they already hold the hands at the rest position
         "left": (-0.335, -0.008, 0.046, -1.778, 0.0, 0.0, 0.0),

@@ -48,6 +48,7 @@ def shoulder_frame_quat(sign: float) -> np.ndarray:
 
 class Reachy2(Robot):
     name = "reachy2"
+    visual_assets = "reachy2"
     canonical_origin = (-0.01, 0.0, 0.93)
     # The reference's rest joints (-0.3 shoulder pitch, -1.7 elbow) put the hands below the table top; seed the
     # calibration with the elbows raised and out, so the upper arms stay clear of the table's front edge.

@@ -1,13 +1,18 @@
-"""Task metadata: suite, prompts, success rule and splits, readable without MuJoCo.
+"""The task registry: each task's suite, prompts, success rule, splits, task class and demonstrator, readable
+without MuJoCo.
 
-The simulating task classes live in one module each next to this file; `TASKS` below is the single list of what
-exists, so CLIs and configs can validate names and expand suites without building a simulator.
+`TASKS` below is the one place a task is declared. Its task class (one module each next to this file) and its
+demonstrator (`lerobot_tavis.experts`) are named by import path and imported only when an env or a demonstrator is
+built, so CLIs and configs validate names and expand suites without loading a simulator. Tasks from outside the
+package join with `register_task` (docs/extending.md).
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
+from lerobot_tavis import importpath
 from lerobot_tavis.errors import FieldError, InputError
 
 SPLITS = ("id", "ood_spatial", "ood_init_pose", "ood_visual")
@@ -41,11 +46,17 @@ def split_names() -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class TaskInfo:
+    """One task. `task_class` (an `envs.tasks.base.Task` subclass) and `demonstrator` (an `experts.base.Expert`
+    subclass; None: the task has none) are import paths "package.module:Class", imported on first use, or the
+    classes themselves."""
+
     name: str
     suite: str
     prompts: tuple[str, ...]
     success_rule: str
     splits: tuple[str, ...] = SPLITS
+    task_class: str | type = ""
+    demonstrator: str | type | None = None
 
 
 LIFT_PROMPTS = {
@@ -80,34 +91,50 @@ SHELF_PROMPTS = {
 CUBE_PROMPT = "Find the red cube and pick it up."
 LIFT_RULE = "the {what}'s origin is above {z} m and moving slower than 1 m/s"
 
+TASKS_PKG, HEAD_EXPERTS, HANDS_EXPERTS = ("lerobot_tavis.envs.tasks", "lerobot_tavis.experts.head_tasks",
+                                          "lerobot_tavis.experts.hands_tasks")
+# The registry, in catalog order (tables, datasets, plots follow it). `register_task` adds to it.
 TASKS: dict[str, TaskInfo] = {
     info.name: info
     for info in (
         TaskInfo("conditional_pick", "tavis_head",
                  ("Look at the card. If it is red, pick the object on the left. If it is green, pick the object on "
                   "the right.",),
-                 LIFT_RULE.format(what="target (left object if the card is red, right if green)", z=1.2)),
+                 LIFT_RULE.format(what="target (left object if the card is red, right if green)", z=1.2),
+                 task_class=f"{TASKS_PKG}.conditional_pick:ConditionalPick",
+                 demonstrator=f"{HEAD_EXPERTS}:ConditionalPickExpert"),
         TaskInfo("wait_then_act", "tavis_head",
                  ("Watch the red light. When it turns green, pick up the object.",),
-                 "once the light is green: " + LIFT_RULE.format(what="object", z=1.2)),
-        TaskInfo("clutter_pick_cube", "tavis_head", (CUBE_PROMPT,), LIFT_RULE.format(what="red cube", z=1.2)),
+                 "once the light is green: " + LIFT_RULE.format(what="object", z=1.2),
+                 task_class=f"{TASKS_PKG}.wait_then_act:WaitThenAct", demonstrator=f"{HEAD_EXPERTS}:WaitThenActExpert"),
+        TaskInfo("clutter_pick_cube", "tavis_head", (CUBE_PROMPT,), LIFT_RULE.format(what="red cube", z=1.2),
+                 task_class=f"{TASKS_PKG}.clutter_pick_cube:ClutterPickCube",
+                 demonstrator=f"{HEAD_EXPERTS}:ClutterExpert"),
         TaskInfo("clutter_pick_lift", "tavis_head", tuple(p for ps in LIFT_PROMPTS.values() for p in ps),
-                 LIFT_RULE.format(what="named object", z=1.2)),
+                 LIFT_RULE.format(what="named object", z=1.2),
+                 task_class=f"{TASKS_PKG}.clutter_pick_lift:ClutterPickLift",
+                 demonstrator=f"{HEAD_EXPERTS}:ClutterExpert"),
         TaskInfo("multi_shelf_scan", "tavis_head", tuple(p for ps in SHELF_PROMPTS.values() for p in ps),
                  "the named object's origin is closer than x = 0.435 m (out of the shelf) and moving slower than "
-                 "1 m/s"),
+                 "1 m/s",
+                 task_class=f"{TASKS_PKG}.multi_shelf_scan:MultiShelfScan", demonstrator=f"{HEAD_EXPERTS}:ShelfExpert"),
         TaskInfo("peeking_box", "tavis_hands", ("Retrieve the object from inside the box.",),
-                 LIFT_RULE.format(what="object", z=1.25)),
+                 LIFT_RULE.format(what="object", z=1.25),
+                 task_class=f"{TASKS_PKG}.peeking_box:PeekingBox", demonstrator=f"{HANDS_EXPERTS}:PeekingBoxExpert"),
         TaskInfo("occluded_reach", "tavis_hands", ("Reach around the screen and pick up the object behind it.",),
-                 LIFT_RULE.format(what="object", z=1.25)),
+                 LIFT_RULE.format(what="object", z=1.25),
+                 task_class=f"{TASKS_PKG}.occluded_reach:OccludedReach",
+                 demonstrator=f"{HANDS_EXPERTS}:OccludedReachExpert"),
         TaskInfo("blocked_clutter_pick_cube", "tavis_hands", (CUBE_PROMPT,),
-                 LIFT_RULE.format(what="red cube", z=1.2) + "; the head camera image is black"),
+                 LIFT_RULE.format(what="red cube", z=1.2) + "; the head camera image is black",
+                 task_class=f"{TASKS_PKG}.blocked_clutter_pick_cube:BlockedClutterPickCube",
+                 demonstrator=f"{HANDS_EXPERTS}:BlockedClutterExpert"),
         TaskInfo("tabletop", "sandbox", ("Look at the objects on the table.",),
                  "never succeeds: a free scene (the five YCB objects on the table) for trying the robots",
-                 splits=("id",)),
+                 splits=("id",), task_class=f"{TASKS_PKG}.tabletop:Tabletop"),
     )
 }
-SUITES = ("tavis_head", "tavis_hands")
+SUITES = ("tavis_head", "tavis_hands")  # the benchmark's suites: closed, `register_task` adds to other suites
 
 
 def suite_tasks(suite: str) -> tuple[str, ...]:
@@ -120,6 +147,59 @@ def suite_tasks(suite: str) -> tuple[str, ...]:
 
 
 BENCHMARK_TASKS = tuple(name for suite in SUITES for name in suite_tasks(suite))  # the eight TAVIS tasks
+BUILTIN_TASKS = tuple(TASKS)  # the benchmark's and `tabletop`
+NAME_PATTERN = re.compile(r"[a-z][a-z0-9_]*")
+
+
+def suite_names() -> tuple[str, ...]:
+    """Every suite with a task (the benchmark's, `sandbox` and registered ones), in catalog order."""
+    return tuple(dict.fromkeys(info.suite for info in TASKS.values()))
+
+
+def task_names(suite: str | None = None) -> tuple[str, ...]:
+    """Every registered task name, or those of `suite`, in catalog order."""
+    return tuple(TASKS) if suite is None else suite_tasks(suite)
+
+
+def register_task(info: TaskInfo) -> TaskInfo:
+    """Add a task from outside the package (docs/extending.md). Its suite must not be one of the benchmark's
+    (`SUITES`: the eight TAVIS tasks are fixed); its splits must include `id`. Returns `info`."""
+    if not (isinstance(info, TaskInfo) and NAME_PATTERN.fullmatch(info.name)):
+        raise ValueError(f"task name must be lower_snake_case (a TaskInfo), got {getattr(info, 'name', info)!r}")
+    if info.name in TASKS:
+        raise ValueError(f"task {info.name!r} is already registered")
+    if info.name in suite_names() or info.suite in TASKS:
+        raise ValueError(f"task {info.name!r} of suite {info.suite!r}: a task and a suite may not share a name")
+    if not NAME_PATTERN.fullmatch(info.suite) or info.suite in SUITES:
+        raise ValueError(f"suite of task {info.name!r} must be lower_snake_case and none of the benchmark's "
+                         f"{SUITES}, got {info.suite!r}")
+    if not (isinstance(info.prompts, tuple) and info.prompts and all(isinstance(p, str) and p for p in info.prompts)):
+        raise ValueError(f"prompts of task {info.name!r} must be a non-empty tuple of texts, got {info.prompts!r}")
+    if "id" not in info.splits or not set(info.splits) <= set(SPLITS):
+        raise ValueError(f"splits of task {info.name!r} must include 'id' and be among {SPLITS}, got {info.splits!r}")
+    importpath.check("task_class", info.task_class)
+    importpath.check("demonstrator", info.demonstrator, optional=True)
+    TASKS[info.name] = info
+    return info
+
+
+def unregister_task(name: str) -> None:
+    """Remove a task added by `register_task` (tests clean up with it); the built-in tasks stay."""
+    if name in BUILTIN_TASKS:
+        raise ValueError(f"task {name!r} is built in and cannot be unregistered")
+    task_info(name)
+    del TASKS[name]
+
+
+def task_class(name: str) -> type:
+    """The `Task` subclass of task `name` (importing it loads MuJoCo)."""
+    return importpath.resolve(task_info(name).task_class)
+
+
+def demonstrator_class(name: str) -> type | None:
+    """The scripted demonstrator (`Expert` subclass) of task `name`, or None if it has none."""
+    demonstrator = task_info(name).demonstrator
+    return None if demonstrator is None else importpath.resolve(demonstrator)
 
 
 def task_sort_key(name: str) -> tuple[int, str]:
@@ -139,7 +219,7 @@ def expand_tasks(spec: str) -> dict[str, list[str]]:
     """`tavis_head`, `peeking_box` or `tavis_head,occluded_reach` -> {suite: [task, ...]}, in the given order."""
     groups: dict[str, list[str]] = {}
     for item in (part.strip() for part in spec.split(",")):
-        names = suite_tasks(item) if item in SUITES else (task_info(item).name,)
+        names = suite_tasks(item) if item in suite_names() else (task_info(item).name,)
         for name in names:
             suite = task_info(name).suite
             if name not in groups.setdefault(suite, []):
