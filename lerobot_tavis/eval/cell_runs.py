@@ -166,7 +166,8 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
 
     from lerobot_tavis.envs.config import TavisEnvConfig
 
-    _share_cores(cfg.workers)
+    if cfg.device != "cpu":
+        _share_cores(cfg.workers)
     policy = policy_config(cfg)
     batch = min(cfg.batch_size, chunk.n)
     with tempfile.TemporaryDirectory(prefix="tavis-chunk-") as scratch:
@@ -189,7 +190,9 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
 def _share_cores(jobs: int) -> None:
     """Give this job's torch its share of the machine's cores. Each process's torch uses every core by default, so
     `jobs` policy jobs at once oversubscribed them (16-core GPU machine, 5 jobs: 80 torch threads, each job's main
-    process at 200-500% CPU while its env workers waited)."""
+    process at 200-500% CPU while its env workers waited). Only for a policy on an accelerator: there the CPU work
+    is element-wise; a policy on the CPU keeps torch's default, as its results would depend on the thread count,
+    and so on `--workers`."""
     import torch
 
     torch.set_num_threads(max(1, (os.cpu_count() or 1) // jobs))
