@@ -20,6 +20,9 @@ from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.tasks.catalog import TaskInfo
 
 MAX_SUCCESS_SPEED_M_S = 1.0
+# `evaluate` reports measured quantities to the millimetre (mm/s): bit-level differences between runs of the same
+# episode (a policy's arithmetic in another process, say) stay out of the episode log. Decisions use exact values.
+MEASURE_DECIMALS = 3
 
 
 class Task(abc.ABC):
@@ -93,10 +96,10 @@ class YcbTask(Task, abc.ABC):
 def lift_conditions(model: mujoco.MjModel, data: mujoco.MjData, body: str,
                     height_m: float) -> dict[str, bool | float]:
     """The reference's lift rule, part by part: the body's origin above `height_m` (world z; `target_lifted`) and
-    slower than 1 m/s (`target_slow`), with the measured height (m) and speed (m/s)."""
+    slower than 1 m/s (`target_slow`), with the measured height (m) and speed (m/s), to `MEASURE_DECIMALS`."""
     height = float(data.xpos[model.body(body).id][2])
     speed = body_speed(model, data, body)
     lifted, slow = height > height_m, speed < MAX_SUCCESS_SPEED_M_S
     return {"success": lifted and slow, "target_lifted": lifted, "target_slow": slow,
-            "target_height_m": height, "target_speed_m_s": speed}
+            "target_height_m": round(height, MEASURE_DECIMALS), "target_speed_m_s": round(speed, MEASURE_DECIMALS)}
 
