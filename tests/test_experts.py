@@ -1,9 +1,14 @@
 """The scripted demonstrators: they finish their tasks, look first, and are reproducible."""
 
+import json
+
+import gymnasium as gym
 import numpy as np
 import pytest
 
 from lerobot_tavis.envs.env import TavisEnv
+from lerobot_tavis.envs.tasks.multi_shelf_scan import SUCCESS_X
+from lerobot_tavis.eval.episode_log import EpisodeLogger
 from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
 from lerobot_tavis.experts.base import Hold, Move, play
 from lerobot_tavis.experts.registry import make_expert, run_episode
@@ -33,6 +38,44 @@ def test_demonstrator_completes_its_task(tiny_env, task):
     assert any(r.success for r in results), f"{task}: no success in 3 seeds"
     for result in results:
         assert result.actions.shape == (result.length_steps, 19) and np.isfinite(result.actions).all()
+
+
+def _rule_before_evaluate(env) -> bool:
+    """Each task's success decision as `is_success` computed it before `Task.evaluate` existed."""
+    task, model, data = env.task_object, env.model, env.data
+    body = model.body(task.target).id
+    dof = model.jnt_dofadr[model.body(task.target).jntadr[0]]
+    slow = np.linalg.norm(data.qvel[dof:dof + 3]) < 1.0
+    if env.task == "multi_shelf_scan":
+        return bool(data.xpos[body][0] < SUCCESS_X and slow)
+    lifted = bool(data.xpos[body][2] > task.success_height_m and slow)
+    return task.is_green and lifted if env.task == "wait_then_act" else lifted
+
+
+class _Steps(gym.Wrapper):
+    """Keeps every step's info beside the old success rule evaluated on the same state."""
+
+    def __init__(self, env):
+        super().__init__(env)
+        self.steps = []
+
+    def step(self, action):
+        *rest, info = self.env.step(action)
+        self.steps.append((_rule_before_evaluate(self.env.unwrapped), info))
+        return *rest, info
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_evaluate_decides_as_before_over_a_demonstration_and_the_log_keeps_its_conditions(tiny_env, task, tmp_path):
+    log = tmp_path / "episodes.jsonl"
+    env = _Steps(EpisodeLogger(tiny_env(task, cameras=()), log, "suite", 0))
+    result = run_episode(env, seed=0)
+    for old, info in env.steps:
+        assert info["is_success"] == old
+        flags = [value for value in info["conditions"].values() if isinstance(value, bool)]
+        assert flags and info["is_success"] == all(flags), info["conditions"]
+    (record,) = [json.loads(line) for line in log.read_text().splitlines()]
+    assert record["success"] == result.success and record["conditions"] == env.steps[-1][1]["conditions"]
 
 
 @pytest.mark.parametrize("task", ["conditional_pick", "clutter_pick_lift"])

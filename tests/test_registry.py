@@ -18,7 +18,7 @@ from lerobot_tavis.cli import build_parser
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import RED_CUBE, add_prop
 from lerobot_tavis.envs.robots.gr1t2 import GR1T2
-from lerobot_tavis.envs.tasks.base import Task, lifted_above
+from lerobot_tavis.envs.tasks.base import Task, lift_conditions
 from lerobot_tavis.envs.tasks.catalog import expand_tasks
 from lerobot_tavis.experts.base import Expert, Hold, Move, Segment
 from lerobot_tavis.experts.registry import make_expert, run_episode
@@ -47,8 +47,8 @@ class ToyLiftCube(Task):
         y = rng.uniform(-self.variant, self.variant)
         placement.place_on_table(model, data, RED_CUBE.name, 0.42, y, rng.uniform(-np.pi, np.pi))
 
-    def is_success(self, data) -> bool:
-        return lifted_above(self._model, data, RED_CUBE.name, 1.2)
+    def evaluate(self, data) -> dict:
+        return lift_conditions(self._model, data, RED_CUBE.name, 1.2)
 
 
 class ToyReachExpert(Expert):

@@ -73,7 +73,9 @@ class TavisEnv(gym.Env):
     they need themselves.
 
     An episode ends early, truncated and unsuccessful, if MuJoCo reports an instability (it then resets the
-    simulation state itself); `info["instability"]` names the warning and when it fired.
+    simulation state itself); `info["instability"]` names the warning and when it fired. Otherwise every step's
+    `info["conditions"]` holds the parts of the task's success rule (`Task.evaluate` less "success", which is
+    `info["is_success"]`), e.g. `{"target_lifted": True, "target_slow": False, "target_height_m": 1.31, ...}`.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": physics.POLICY_HZ}
@@ -159,11 +161,13 @@ class TavisEnv(gym.Env):
                     "instability": f"{unstable} at step {self._steps} ({self._steps / self.fps:.2f} s)"}
             return self._observe(sim), 0.0, False, True, info
         self._task.after_step(sim.model, sim.data, self._steps / self.fps)
-        success = bool(self._task.is_success(sim.data))
+        evaluation = self._task.evaluate(sim.data)
+        success = bool(evaluation["success"])
         if success and self._success_s is None:
             self._success_s = self._steps / self.fps
         truncated = self._steps >= self._max_episode_steps and not success
-        info = {"is_success": success, "applied_action": applied}
+        conditions = {name: value for name, value in evaluation.items() if name != "success"}
+        info = {"is_success": success, "applied_action": applied, "conditions": conditions}
         return self._observe(sim), float(success), success, truncated, info
 
     def render(self) -> np.ndarray:

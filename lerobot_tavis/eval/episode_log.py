@@ -1,11 +1,13 @@
-"""One JSON line per finished episode: who, what, which seed, success, length and every episode metric.
+"""One JSON line per finished episode: who, what, which seed, success, length, success conditions and every episode
+metric.
 
 The wrapper sits inside `envs.vector.FreezeAfterEpisodeEnd`, so it sees each genuine episode once. It records the
 actions the env actually applied (after clipping, and with the neck zeroed in fixed-camera modes) and, when an
 episode ends, writes the fields of every metric of `lerobot_tavis.metrics.registry`, in its order, computed from
 them at the env's rate (20 Hz in evaluation): GALT for successful episodes of head-camera modes, as the reference
 does, and the wrist lead of the final grasp for successful TAVIS-Hands episodes. The metric fields are also added
-to that step's `info`.
+to that step's `info`. Before them, `conditions` holds the final step's `info["conditions"]`: the parts of the
+task's success rule (`Task.evaluate`), or null when the env gave none (an episode ended by an instability).
 """
 
 from __future__ import annotations
@@ -47,7 +49,8 @@ class EpisodeLogger(gym.Wrapper):
         if terminated or truncated:
             success = bool(info["is_success"])
             metrics = self._metrics(success)
-            self._append(self._record(success) | metrics | {"instability": info.get("instability")})
+            conditions = {"conditions": info.get("conditions")}
+            self._append(self._record(success) | conditions | metrics | {"instability": info.get("instability")})
             info = {**info, **metrics}
         return obs, reward, terminated, truncated, info
 

@@ -28,8 +28,8 @@ class EmptyRoom(Task):
     def initialize_episode(self, model, data, rng):
         pass
 
-    def is_success(self, data):
-        return False
+    def evaluate(self, data):
+        return {"success": False}
 
 
 def _settle(controller, model, data, action, seconds):

@@ -171,6 +171,57 @@ def test_success_fires_above_the_threshold_and_not_below(task_name):
     assert not task.is_success(data)
 
 
+def _pose_and_speed(model, data, task, where, speed_m_s=0.0):
+    placement.set_free_pose(model, data, task.target, where)
+    data.qvel[model.jnt_dofadr[model.body(task.target).jntadr[0]]] = speed_m_s
+    mujoco.mj_forward(model, data)
+    return task.evaluate(data)
+
+
+def test_evaluate_shows_which_part_of_the_lift_rule_fails():
+    task, model, data = _world("conditional_pick", "id")
+    task.initialize_episode(model, data, np.random.default_rng(0))
+    fast = _pose_and_speed(model, data, task, (0.4, 0.0, 1.3), speed_m_s=1.5)  # lifted but moving fast
+    assert fast["success"] is False and fast["target_lifted"] is True and fast["target_slow"] is False
+    assert fast["target_height_m"] == pytest.approx(1.3) and fast["target_speed_m_s"] == pytest.approx(1.5)
+    low = _pose_and_speed(model, data, task, (0.4, 0.0, 1.1))  # slow but below 1.2 m
+    assert low["success"] is False and low["target_lifted"] is False and low["target_slow"] is True
+    assert list(low) == ["success", "target_lifted", "target_slow", "target_height_m", "target_speed_m_s"]
+    up = _pose_and_speed(model, data, task, (0.4, 0.0, 1.3))
+    assert up["success"] is True and up["success"] == task.is_success(data)
+
+
+def test_evaluate_shows_an_object_still_in_the_shelf():
+    task, model, data = _world("multi_shelf_scan", "id")
+    task.initialize_episode(model, data, np.random.default_rng(0))
+    inside = _pose_and_speed(model, data, task, (0.50, 0.0, 1.2))
+    assert inside["success"] is False and inside["target_out_of_shelf"] is False and inside["target_slow"] is True
+    assert inside["target_x_m"] == pytest.approx(0.50)
+    out = _pose_and_speed(model, data, task, (0.40, 0.0, 1.2))
+    assert out["success"] is True and out["target_out_of_shelf"] is True
+
+
+def test_evaluate_shows_a_lift_before_the_light_is_green():
+    task, model, data = _world("wait_then_act", "id")
+    task.initialize_episode(model, data, np.random.default_rng(0))
+    task.after_step(model, data, 0.0)
+    early = _pose_and_speed(model, data, task, (0.4, 0.0, 1.3))
+    assert early["success"] is False and early["light_green"] is False
+    assert early["target_lifted"] is True and early["target_slow"] is True
+    task.after_step(model, data, task.green_at_s)
+    assert task.evaluate(data)["success"] is True and task.evaluate(data)["light_green"] is True
+
+
+@pytest.mark.parametrize("task_name", [*TAVIS_TASKS, "tabletop"])
+def test_evaluate_gives_plain_json_values(task_name):
+    task, model, data = _world(task_name, "id")
+    task.initialize_episode(model, data, np.random.default_rng(0))
+    mujoco.mj_forward(model, data)
+    evaluation = task.evaluate(data)
+    assert next(iter(evaluation)) == "success" and evaluation["success"] is False
+    assert all(type(value) in (bool, float) for value in evaluation.values()), evaluation
+
+
 def test_wait_then_act_counts_success_only_once_green():
     task, model, data = _world("wait_then_act", "id")
     task.initialize_episode(model, data, np.random.default_rng(0))

@@ -1,4 +1,5 @@
-"""The episode log: one line per genuine episode, with GALT for successful head-camera episodes."""
+"""The episode log: one line per genuine episode, with the final step's success conditions and GALT for successful
+head-camera episodes."""
 
 import json
 
@@ -36,7 +37,8 @@ class ScriptedEnv(gym.Env):
         done = self.t == len(self.actions)
         success = done and self.success
         return np.zeros(1, np.float32), float(success), success, done and not success, {
-            "is_success": success, "applied_action": applied}
+            "is_success": success, "applied_action": applied,
+            "conditions": {"target_lifted": done, "target_slow": success, "target_height_m": 1.0 + 0.01 * self.t}}
 
 
 def _run(env, seed, steps):
@@ -56,6 +58,8 @@ def test_a_successful_episode_is_logged_once_with_its_galt(tmp_path):
     (record,) = [json.loads(line) for line in log.read_text().splitlines()]
     assert record["seed"] == 1005 and record["success"] and record["length_steps"] == len(actions)
     assert record["suite"] == "tavis_head" and record["task_id"] == 3 and record["task"] == "clutter_pick_lift"
+    assert record["conditions"] == {"target_lifted": True, "target_slow": True,
+                                    "target_height_m": 1.0 + 0.01 * len(actions)}  # the final step's
     assert record["galt_reason"] == "ok" and abs(record["galt_s"] - 1.0) < 0.1 and record["galt_arm"] == "right"
     assert info["galt_s"] == record["galt_s"]
 
@@ -68,6 +72,7 @@ def test_no_galt_for_failures_or_fixed_camera_modes(tmp_path):
         _run(env, 7, len(actions))
     records = [json.loads(line) for line in log.read_text().splitlines()]
     assert len(records) == 2 and [r["success"] for r in records] == [False, True]
+    assert records[0]["conditions"]["target_lifted"] and not records[0]["conditions"]["target_slow"]
     assert all(r[field] is None for r in records for field in GALT.fields + WRIST_LEAD.fields)
 
 
@@ -87,5 +92,5 @@ def test_the_log_writes_the_fields_of_every_metric_in_registry_order(tmp_path):
     info = _run(EpisodeLogger(ScriptedEnv(actions), log, "tavis_head", 0), 0, len(actions))
     (record,) = [json.loads(line) for line in log.read_text().splitlines()]
     assert list(record) == ["robot", "suite", "task", "task_id", "split", "camera_mode", "seed", "success",
-                            "length_steps", "prompt", *GALT.fields, *WRIST_LEAD.fields, "instability"]
+                            "length_steps", "prompt", "conditions", *GALT.fields, *WRIST_LEAD.fields, "instability"]
     assert all(info[field] == record[field] for field in GALT.fields + WRIST_LEAD.fields)

@@ -66,6 +66,7 @@ def test_an_episode_ended_by_an_instability_logs_the_warning(tmp_path, monkeypat
     env.step(canonical.rest_action())
     (record,) = [json.loads(line) for line in log.read_text().splitlines()]
     assert not record["success"] and record["instability"].startswith("mjWARN_BADQVEL at step 2")
+    assert record["conditions"] is None  # the state was reset: nothing to evaluate
     env.close()
 
 

@@ -3,7 +3,8 @@
 Life cycle: `build(spec)` adds the task's props and scenery to the world spec; after compilation `bind(model)`
 resolves ids; every episode `initialize_episode(model, data, rng)` places things (all randomness from `rng`) and
 picks the prompt; after each env step `after_step(model, data, elapsed_s)` updates task state (a light, say) and
-`is_success(data)` is checked.
+`evaluate(data)` is checked: `{"success": bool, <sub-condition>: bool or float, ...}`, the parts the task's success
+rule combines (and the quantities they test), plain Python values that go into `info` and the episode log.
 """
 
 from __future__ import annotations
@@ -19,6 +20,9 @@ from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.tasks.catalog import TaskInfo
 
 MAX_SUCCESS_SPEED_M_S = 1.0
+# `evaluate` reports measured quantities to the millimetre (mm/s): bit-level differences between runs of the same
+# episode (a policy's arithmetic in another process, say) stay out of the episode log. Decisions use exact values.
+MEASURE_DECIMALS = 3
 
 
 class Task(abc.ABC):
@@ -54,8 +58,12 @@ class Task(abc.ABC):
         return np.zeros(0)
 
     @abc.abstractmethod
+    def evaluate(self, data: mujoco.MjData) -> dict[str, bool | float]:
+        """`{"success": bool, <sub-condition>: bool or float, ...}` for the current state: "success" first, then the
+        conditions the success rule combines and the measured quantities they test (SI units, world frame)."""
+
     def is_success(self, data: mujoco.MjData) -> bool:
-        ...
+        return bool(self.evaluate(data)["success"])
 
     def props(self) -> tuple[str, ...]:
         """Names of the free bodies whose motion must die down before the first observation."""
@@ -81,11 +89,17 @@ class YcbTask(Task, abc.ABC):
     def props(self) -> tuple[str, ...]:
         return OBJECT_NAMES
 
-    def is_success(self, data: mujoco.MjData) -> bool:
-        return lifted_above(self._model, data, self.target, self.success_height_m)
+    def evaluate(self, data: mujoco.MjData) -> dict[str, bool | float]:
+        return lift_conditions(self._model, data, self.target, self.success_height_m)
 
 
-def lifted_above(model: mujoco.MjModel, data: mujoco.MjData, body: str, height_m: float) -> bool:
-    """The reference's lift rule: the body's origin above `height_m` (world z) and slower than 1 m/s."""
-    return bool(data.xpos[model.body(body).id][2] > height_m
-                and body_speed(model, data, body) < MAX_SUCCESS_SPEED_M_S)
+def lift_conditions(model: mujoco.MjModel, data: mujoco.MjData, body: str,
+                    height_m: float) -> dict[str, bool | float]:
+    """The reference's lift rule, part by part: the body's origin above `height_m` (world z; `target_lifted`) and
+    slower than 1 m/s (`target_slow`), with the measured height (m) and speed (m/s), to `MEASURE_DECIMALS`."""
+    height = float(data.xpos[model.body(body).id][2])
+    speed = body_speed(model, data, body)
+    lifted, slow = height > height_m, speed < MAX_SUCCESS_SPEED_M_S
+    return {"success": lifted and slow, "target_lifted": lifted, "target_slow": slow,
+            "target_height_m": round(height, MEASURE_DECIMALS), "target_speed_m_s": round(speed, MEASURE_DECIMALS)}
+

@@ -14,7 +14,7 @@ import numpy as np
 from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.placement import body_speed
-from lerobot_tavis.envs.tasks.base import MAX_SUCCESS_SPEED_M_S, YcbTask
+from lerobot_tavis.envs.tasks.base import MAX_SUCCESS_SPEED_M_S, MEASURE_DECIMALS, YcbTask
 from lerobot_tavis.envs.tasks.catalog import SHELF_PROMPTS, TASKS
 
 SHELF_X, SHELF_DEPTH, SHELF_WIDTH = 0.52, 0.11, 0.70
@@ -87,7 +87,11 @@ class MultiShelfScan(YcbTask):
             surface = BOARD_Z[shelf] + BOARD_THICKNESS / 2
             placement.set_free_pose(model, data, name, (x, y, placement.standing_z(name, surface)), yaw)
 
-    def is_success(self, data) -> bool:
-        body = self._model.body(self.target).id
-        return bool(data.xpos[body][0] < SUCCESS_X
-                    and body_speed(self._model, data, self.target) < MAX_SUCCESS_SPEED_M_S)
+    def evaluate(self, data) -> dict[str, bool | float]:
+        """`target_out_of_shelf`: the origin nearer than x = 0.435 m (`target_x_m`); `target_slow`: slower than
+        1 m/s (`target_speed_m_s`); measures to `MEASURE_DECIMALS`."""
+        x = float(data.xpos[self._model.body(self.target).id][0])
+        speed = body_speed(self._model, data, self.target)
+        out, slow = x < SUCCESS_X, speed < MAX_SUCCESS_SPEED_M_S
+        return {"success": out and slow, "target_out_of_shelf": out, "target_slow": slow,
+                "target_x_m": round(x, MEASURE_DECIMALS), "target_speed_m_s": round(speed, MEASURE_DECIMALS)}

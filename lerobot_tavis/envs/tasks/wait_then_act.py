@@ -75,8 +75,11 @@ class WaitThenAct(YcbTask):
     def task_state(self) -> np.ndarray:
         return np.array([float(self.is_green)])
 
-    def is_success(self, data) -> bool:
-        return self.is_green and super().is_success(data)
+    def evaluate(self, data) -> dict[str, bool | float]:
+        """The lift rule's conditions and `light_green`; success needs all three."""
+        lift = super().evaluate(data)
+        return {"success": self.is_green and lift["success"], "light_green": self.is_green,
+                **{name: value for name, value in lift.items() if name != "success"}}
 
     def _set_green(self, model, green: bool) -> None:
         self.is_green = green
