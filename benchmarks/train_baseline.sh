@@ -2,7 +2,7 @@
 # One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact ACT policy -> evaluation
 # of every checkpoint (96 episodes each, Wilson intervals and GALT by `tavis report`).
 #
-#   benchmarks/train_baseline.sh data|train|eval|overfit
+#   benchmarks/train_baseline.sh cell|data|train|eval|overfit
 #
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
@@ -10,6 +10,9 @@
 # 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), WORK
 # (/tmp/tavis_baseline).
 #
+# - cell: the whole cell within one 30-minute GPU slot: data, then training stopped after TRAIN_S seconds (780)
+#   with BATCH 128 and SAVE_FREQ 1500 unless set (loaders: WORKERS - 2), the checkpoints evaluated at low CPU
+#   priority as they appear, and those left after training ends.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
@@ -58,12 +61,25 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]
 evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES
   lerobot-eval --policy.path="$1/pretrained_model" --policy.device=cuda --policy.use_amp=true --env.type=tavis \
     --env.task="$TASK" --env.robot="$ROBOT" --env.camera_mode="$CONDITION" --env.image_size="[${SIZE/x/,}]" \
-    --seed="$3" --eval.n_episodes="$4" --eval.batch_size=$(( $4 < 32 ? $4 : 32 )) --eval.use_async_envs=true \
+    --seed="$3" --eval.n_episodes="$4" --eval.batch_size=$(( $4 < 48 ? $4 : 48 )) --eval.use_async_envs=true \
     --output_dir="$2"
   tavis report "$2"
 }
 
 case "${1:-}" in
+  cell)
+    "$0" data
+    stopped="$WORK/train_$CONDITION.stopped"
+    rm -f "$stopped"
+    ( BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1500} STEPS=${STEPS:-1000000} \
+        WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-780}" "$0" train || true
+      touch "$stopped" ) &
+    while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
+      nice -n 15 "$0" eval
+      sleep 10
+    done
+    "$0" eval
+    ;;
   data)
     [ -f "$WORK/raw/manifest.json" ] || time tavis record --robot "$ROBOT" --tasks "$TASK" \
       --episodes-per-task "$EPISODES" --workers "$WORKERS" --out "$WORK/raw"
@@ -75,7 +91,8 @@ case "${1:-}" in
       ${SAVE_FREQ:+--save_freq=$SAVE_FREQ} ${BATCH:+--batch_size=$BATCH}
     ;;
   eval)  # every complete checkpoint (up to the one `last` points at), so it may run while training goes on
-    last=$(basename "$(readlink "$WORK/train_$CONDITION/checkpoints/last" 2>/dev/null)") || exit 0
+    link=$(readlink "$WORK/train_$CONDITION/checkpoints/last") 2>/dev/null || exit 0  # no checkpoint yet
+    last=$(basename "$link")
     for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
       (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
       out="$WORK/eval_$CONDITION/step_$((10#$(basename "$checkpoint")))"
@@ -100,7 +117,7 @@ PY
     evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/new_seeds" 1000 8
     ;;
   *)
-    echo "usage: $0 data|train|eval|overfit" >&2
+    echo "usage: $0 cell|data|train|eval|overfit" >&2
     exit 2
     ;;
 esac
