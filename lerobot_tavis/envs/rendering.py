@@ -46,7 +46,8 @@ class CameraRig:
     def _ensure_renderer(self) -> mujoco.Renderer:
         if self._renderer is None:
             try:
-                self._renderer = mujoco.Renderer(self._model, height=self.height, width=self.width)
+                self._renderer = mujoco.Renderer(self._model, height=self.height, width=self.width,
+                                                 max_geom=2 * self._model.ngeom + 100)
             except mujoco.FatalError as error:
                 raise NoOpenGLError(
                     f"MuJoCo could not create an OpenGL context ({error}). MuJoCo picks its backend when it is "
