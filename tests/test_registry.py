@@ -1,8 +1,9 @@
 """The registry: one declaration per task, robot and camera mode, readable without MuJoCo, open to additions.
 
 The toy task, demonstrator and robot below are the working examples docs/extending.md points at: a researcher's
-task is a `Task` subclass plus an `Expert` subclass plus one `register_task` call; a robot is a `Robot` subclass
-plus one `register_robot` call; a camera mode is one `register_camera_mode` call.
+task is a `Task` subclass (declaring the episode facts its demonstrator reads) plus an `Expert` subclass plus one
+`register_task` call; a robot is a `Robot` subclass plus one `register_robot` call; a camera mode is one
+`register_camera_mode` call.
 """
 
 import json
@@ -18,7 +19,7 @@ from lerobot_tavis.cli import build_parser
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import RED_CUBE, add_prop
 from lerobot_tavis.envs.robots.gr1t2 import GR1T2
-from lerobot_tavis.envs.tasks.base import Task, lift_conditions
+from lerobot_tavis.envs.tasks.base import TargetFacts, Task, lift_conditions
 from lerobot_tavis.envs.tasks.catalog import expand_tasks
 from lerobot_tavis.experts.base import Expert, Hold, Move, Segment
 from lerobot_tavis.experts.registry import make_expert, run_episode
@@ -47,17 +48,24 @@ class ToyLiftCube(Task):
         y = rng.uniform(-self.variant, self.variant)
         placement.place_on_table(model, data, RED_CUBE.name, 0.42, y, rng.uniform(-np.pi, np.pi))
 
+    def episode_facts(self) -> TargetFacts:
+        """What the demonstrator may know: the prop to pick (here always the cube) and the scene's props."""
+        return TargetFacts(props=self.props(), succeeds=self.is_success, target=RED_CUBE.name)
+
     def evaluate(self, data) -> dict:
         return lift_conditions(self._model, data, RED_CUBE.name, 1.2)
 
 
 class ToyReachExpert(Expert):
-    """Look down at the table and move the right hand 10 cm forward; no grasp."""
+    """Look down toward the target (named by the task's facts, found in the simulator state) and move the right hand
+    10 cm forward; no grasp."""
 
     def behaviour(self) -> Iterator[Segment]:
         yield Hold(self.uniform(0.05, 0.1))
+        cube = self.env.data.xpos[self.env.model.body(self.facts.target).id]
         target = canonical.rest_action()
         target[canonical.HEAD_PITCH] = 0.4
+        target[canonical.HEAD_YAW] = np.arctan2(cube[1], cube[0])
         target[canonical.RIGHT.position.start] += 0.1
         yield Move(target, 0.5)
 
@@ -123,13 +131,17 @@ def test_a_registered_task_robot_and_mode_run_in_the_env_with_the_demonstrator(t
         assert obs["agent_pos"][canonical.HEAD] == pytest.approx(0.0)  # a fixed-camera mode holds the neck
         expert = make_expert(env, seed=3)
         assert isinstance(expert, ToyReachExpert)
+        assert env.episode_facts.target == RED_CUBE.name and env.episode_facts.props == (RED_CUBE.name,)
         expert.reset()
         start = obs["agent_pos"].copy()
         for _ in range(15):
-            obs, reward, terminated, truncated, info = env.step(expert.act())
+            obs, reward, terminated, truncated, info = env.step(action := expert.act())
         assert not (terminated or truncated or info["is_success"])
         assert obs["agent_pos"][canonical.RIGHT.position.start] > start[canonical.RIGHT.position.start] + 0.05
         cube = env.model.body(RED_CUBE.name).id
+        # the expert turned its gaze toward the cube the facts named (the fixed-camera mode then holds the neck)
+        x, y, _ = env.data.xpos[cube]
+        assert action[canonical.HEAD_YAW] == pytest.approx(np.arctan2(y, x), abs=1e-3)
         first = env.data.xpos[cube].copy()
         env.reset(seed=3)
         assert np.allclose(env.data.xpos[cube], first, atol=1e-3)  # same seed, same layout

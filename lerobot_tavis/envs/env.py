@@ -22,6 +22,7 @@ from lerobot_tavis.envs.modes import (CAMERA_NAMES, DEFAULT_CAMERA_MODE, OVERVIE
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
+from lerobot_tavis.envs.tasks.base import EpisodeFacts
 from lerobot_tavis.envs.tasks.catalog import VISUAL_SPLIT, parse_split, task_info
 from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.world import World, build_world
@@ -115,6 +116,7 @@ class TavisEnv(gym.Env):
         self.visual_draw = None  # ood_visual: the look drawn for the current episode (visual_ood.VisualDraw)
         self._robot = make_robot(robot)
         self._sim: _Sim | None = None
+        self._facts: EpisodeFacts | None = None
         self._steps = 0
         self._last_frames: dict[str, np.ndarray] | None = None
         self._success_s: float | None = None  # when the task first reported success in this episode
@@ -137,6 +139,7 @@ class TavisEnv(gym.Env):
         mujoco.mj_resetData(sim.model, sim.data)
         sim.controller.reset(sim.data)
         self._task.initialize_episode(sim.model, sim.data, self.np_random)
+        self._facts = self._task.episode_facts()
         self.task_description = self._task.prompt
         mujoco.mj_forward(sim.model, sim.data)
         self._settle(sim)
@@ -211,8 +214,15 @@ class TavisEnv(gym.Env):
 
     @property
     def task_object(self):
-        """The simulating task (layout, prompt, success); experts read it."""
+        """The simulating task (layout, prompt, success). Demonstrators read `episode_facts` instead."""
         return self._task
+
+    @property
+    def episode_facts(self) -> EpisodeFacts:
+        """What the task tells its demonstrator about the current episode (`Task.episode_facts`, taken at reset)."""
+        if self._facts is None:
+            raise RuntimeError("episode facts exist from the first reset(): call reset() first")
+        return self._facts
 
     def _ensure_sim(self) -> _Sim:
         if self._sim is None:

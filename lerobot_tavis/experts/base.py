@@ -1,7 +1,9 @@
 """The scripted-demonstrator runtime: a behaviour is a generator of timed segments, played at the env's rate.
 
 An expert's `behaviour()` yields segments one at a time; each starts from the action commanded when it starts, so
-a behaviour can look at the (privileged) simulator state between segments to decide what to do next. Segments:
+a behaviour can look at the (privileged) simulator state between segments to decide what to do next: the public
+state of the env (`env.model`, `env.data`, `env.world` with the robot) and the facts its task declares for the
+episode (`facts`, an `envs.tasks.base.EpisodeFacts`), never the task object itself. Segments:
 
 - `Move`: arms, grippers and head to a target action; the arms follow a minimum-jerk profile over `duration_s`,
   the head a fast minimum-jerk saccade over `head_s` (starting `head_delay_s` into the move) then holds still, the
@@ -17,12 +19,16 @@ from __future__ import annotations
 import abc
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.physics import POLICY_HZ
 from lerobot_tavis.experts.motion import interpolate_action, min_jerk
+
+if TYPE_CHECKING:
+    from lerobot_tavis.envs.tasks.base import EpisodeFacts
 
 DT_S = 1.0 / POLICY_HZ
 
@@ -123,6 +129,12 @@ class Expert(abc.ABC):
             if not segment.done(0.0):  # e.g. a WaitUntil whose condition already holds
                 return segment
         return Hold(np.inf)
+
+    @property
+    def facts(self) -> EpisodeFacts:
+        """What the task declares about the current episode (target, cue, landmarks, body names; see the task's
+        `EpisodeFacts` subclass), taken when the env was reset."""
+        return self.env.episode_facts
 
     def uniform(self, low: float, high: float) -> float:
         return float(self.rng.uniform(low, high))

@@ -194,11 +194,12 @@ def grasp_candidates(ik: ArmIK, side: str, prop: PropSpec, center: np.ndarray, y
     """Grasps that (1) keep the hand's path clear of `obstacles` ((xy, radius, top z) of the other props) and the
     palm clear of the object, (2) whose grasp pose is kinematically reachable within `tolerance_m` and (3) whose
     carried pose (grasp point + `carry_m`) is reachable within `carry_tolerance_m`, in order of preference:
-    upright hand; azimuth within 45° of `toward_rad` (default: from the shoulder to the object); the given pitch
-    order; azimuth nearest `toward_rad`. Then the others, best-scoring first. Azimuths farther than
-    `max_azimuth_rad` from `toward_rad` are considered only when there is no other."""
+    upright hand; azimuth within 45° of `toward_rad` (default: from the robot's shoulder, at world y
+    `Robot.shoulder_y(side)`, to the object); the given pitch order; azimuth nearest `toward_rad`. Then the others,
+    best-scoring first. Azimuths farther than `max_azimuth_rad` from `toward_rad` are considered only when there is
+    no other."""
     if toward_rad is None:
-        shoulder_y = 0.2 if side == "left" else -0.2
+        shoulder_y = ik.robot.shoulder_y(side)
         toward_rad = float(np.arctan2(center[1] - shoulder_y, max(center[0], 0.05)))
     bottom, top = center[2] - prop.height_m / 2, center[2] + prop.height_m / 2
     gripper = ik.robot.gripper

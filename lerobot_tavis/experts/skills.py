@@ -113,7 +113,7 @@ class SkilledExpert(Expert):
         """Grasps of prop `name` (see `grasp_candidates`) whose approach avoids the other props near it."""
         center, yaw = self.body_pose(name)
         obstacles = [(pos[:2], PROPS[other].footprint_radius_m, pos[2] + PROPS[other].height_m / 2)
-                     for other in self.env.task_object.props()
+                     for other in self.facts.props
                      if other != name and abs((pos := self.body_pose(other)[0])[2] - center[2]) < 0.1]
         return grasp_candidates(self.ik, side, PROPS[name], center, yaw, carry_m=carry_m, obstacles=obstacles,
                                 **kwargs)
@@ -195,7 +195,7 @@ class SkilledExpert(Expert):
         data = self.imagination.rollout(self.env.data, self.env.controller, play(reach + hold, self.command))
         if not self.holding(data, side, name):
             return -1.0
-        if self.env.task_object.is_success(data):
+        if self.facts.succeeds(data):
             return 1.0
         return float(np.dot(data.xpos[body] - start, carry) / max(np.dot(carry, carry), 1e-9))
 

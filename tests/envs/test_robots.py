@@ -46,6 +46,22 @@ def test_reachy2_zero_pose_anchors():
     np.testing.assert_allclose(data.xanchor[model.joint("neck_pitch").id], (-0.01, 0.0, 1.111), atol=1e-3)
 
 
+def test_both_robots_declare_the_shoulder_the_demonstrators_aim_from():
+    """0.2 m is the one value the demonstrators used on both robots before each robot declared it; Reachy2's
+    shoulder pitch and roll axes meet there, GR1T2's shoulder axes pass through y 0.10-0.23 m."""
+    for name in BUILTIN_ROBOTS:
+        robot = make_robot(name)
+        assert (robot.shoulder_y("left"), robot.shoulder_y("right")) == (0.2, -0.2)
+    robot, model, data = _compiled("reachy2")
+    mujoco.mj_forward(model, data)
+    for side, joint in (("left", "l_shoulder_pitch"), ("right", "r_shoulder_roll")):
+        assert data.xanchor[model.joint(joint).id][1] == pytest.approx(robot.shoulder_y(side), abs=1e-9)
+    robot, model, data = _compiled("gr1t2")
+    mujoco.mj_forward(model, data)
+    ys = [data.xanchor[model.joint(j).id][1] for j in robot.arm_joint_names("left")[:3]]
+    assert min(ys) < robot.shoulder_y("left") < max(ys)
+
+
 @pytest.mark.parametrize("name", BUILTIN_ROBOTS)
 def test_cameras_have_the_reference_fields_of_view(name):
     robot, model, _ = _compiled(name)

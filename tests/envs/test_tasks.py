@@ -151,6 +151,38 @@ def test_occluded_reach_layout(variant):
 
 
 @pytest.mark.parametrize("task_name", TAVIS_TASKS)
+def test_episode_facts_name_bodies_of_the_world_and_agree_with_the_episode(task_name):
+    """What a demonstrator reads of a task (`episode_facts`): bodies that exist, this episode's draw, frozen."""
+    task, model, data = _world(task_name, "ood_spatial")
+    rng = np.random.default_rng(6)
+    task.initialize_episode(model, data, rng)
+    facts = task.episode_facts()
+    assert facts.props == task.props() and facts.target == task.target and facts.target in facts.props
+    assert facts.succeeds(data) == task.is_success(data)
+    names = [v for v in vars(facts).values() if isinstance(v, str) and v not in ("+y", "-y")]
+    assert all(_has(model, name) for name in (*facts.props, *names)), names
+    with pytest.raises(AttributeError):
+        facts.target = "elsewhere"
+    if task_name == "conditional_pick":
+        assert (facts.left_object, facts.right_object) == (task.left_object, task.right_object)
+        assert model.body(facts.cue_card).mocapid[0] >= 0
+    if task_name == "wait_then_act":
+        assert model.body(facts.light).mocapid[0] >= 0 and not facts.light_is_green()
+        task.after_step(model, data, task.green_at_s)
+        assert facts.light_is_green()
+    if task_name == "peeking_box":
+        assert facts.open_side == task.open_side and facts.yaw_rad == task.box_yaw
+        np.testing.assert_array_equal(facts.point(0.05, -0.02, 1.1), task.box_point(0.05, -0.02, 1.1))
+        np.testing.assert_allclose(facts.to_box(facts.point(0.05, -0.02, 1.1)[:2]), (0.05, -0.02), atol=1e-12)
+        assert facts.top_z_m == peeking_box.BOTTOM_Z + peeking_box.HEIGHT
+    if task_name == "occluded_reach":
+        panel = model.geom("screen/panel").id
+        assert model.geom_pos[panel][0] == pytest.approx(facts.screen_x_m)
+        assert model.geom_size[panel][1] == pytest.approx(facts.panel_half_width_m)
+    assert not any(isinstance(value, np.ndarray) for value in vars(facts).values())  # nothing shared that can change
+
+
+@pytest.mark.parametrize("task_name", TAVIS_TASKS)
 def test_success_fires_above_the_threshold_and_not_below(task_name):
     task, model, data = _world(task_name, "id")
     task.initialize_episode(model, data, np.random.default_rng(0))

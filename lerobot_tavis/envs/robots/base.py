@@ -28,6 +28,9 @@ class Robot(abc.ABC):
     canonical_origin: ClassVar[tuple[float, float, float]]  # world position of the canonical (hip) frame
     rest_posture_seed: ClassVar[dict[str, tuple[float, ...]]]  # seeds the rest calibration (calibration.py)
     gripper: ClassVar[GripperGeometry]
+    # lateral distance (m, world y) of the left shoulder from the body's mid-plane (the right one mirrors it); the
+    # demonstrators aim a hand's approach from (0, ±shoulder_y_m) to the object
+    shoulder_y_m: ClassVar[float]
     # joint ranges (rad) the IK keeps to, narrower than the servos' own, by joint name
     ik_joint_ranges: ClassVar[dict[str, tuple[float, float]]] = {}
     ik_orientation_cost: ClassVar[float] = 0.3  # weight of 1 rad of hand tilt against 1 m of position error
@@ -91,6 +94,10 @@ class Robot(abc.ABC):
     def neck_range_rad(self) -> np.ndarray:
         """(3, 2) array of neck roll/pitch/yaw limits."""
         return np.array([j.range_rad for j in self.neck_joints()])
+
+    def shoulder_y(self, side: str) -> float:
+        """World y (m) of `side`'s shoulder: +`shoulder_y_m` on the left, -`shoulder_y_m` on the right."""
+        return self.shoulder_y_m if side == "left" else -self.shoulder_y_m
 
     def ee_site(self, side: str) -> str:
         return f"{side}_ee"

@@ -50,6 +50,9 @@ class GR1T2(Robot):
     }
     gripper = GripperGeometry(stroke_m=0.085, palm_length_m=0.07, palm_half_width_m=0.062,
                               finger_length_m=0.055, pad_length_m=0.035, mount_offset_m=0.023)
+    # The shoulder's three axes pass through y = 0.10 (pitch), 0.19 (roll) and 0.23 m (yaw) at the zero pose; 0.2 m is
+    # the value the demonstrators were tuned with on both robots (one constant served both before), as Reachy2's.
+    shoulder_y_m = 0.2
     head_camera = CameraMount(pos=(0.10, 0.0, 0.0), look_at=(1.10, 0.0, 0.0), up=(0.0, 0.0, 1.0),
                               hfov_deg=HEAD_HFOV_DEG)
     # Reference mount: 15 cm above and 5 cm behind the wrist centre, looking 35° down past the fingertips.

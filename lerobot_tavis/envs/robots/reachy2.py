@@ -64,6 +64,7 @@ class Reachy2(Robot):
     ik_orientation_cost = 0.2
     gripper = GripperGeometry(stroke_m=0.105, palm_length_m=0.05, palm_half_width_m=0.072,
                               finger_length_m=0.06, pad_length_m=0.035, mount_offset_m=0.02)
+    shoulder_y_m = SHOULDER_HALF_SPAN_M  # 0.20 m, where the shoulder pitch and roll axes meet (GR1T2 states 0.2 too)
     # The reference's mount, inside the real head's shell: the face plate 37 mm ahead lies within the cameras'
     # near clip (physics.NEAR_CLIP_M), so the camera sees through it, as the reference's (0.15 m clip) does.
     head_camera = CameraMount(pos=(0.02, 0.0, 0.05), look_at=(1.02, 0.0, 0.05), up=(0.0, 0.0, 1.0),

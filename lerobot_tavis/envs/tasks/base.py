@@ -5,11 +5,18 @@ resolves ids; every episode `initialize_episode(model, data, rng)` places things
 picks the prompt; after each env step `after_step(model, data, elapsed_s)` updates task state (a light, say) and
 `evaluate(data)` is checked: `{"success": bool, <sub-condition>: bool or float, ...}`, the parts the task's success
 rule combines (and the quantities they test), plain Python values that go into `info` and the episode log.
+
+What a scripted demonstrator may know of the task is declared here too: `episode_facts()`, an `EpisodeFacts`
+(a frozen dataclass; each task subclasses it with its own facts) that the env takes right after
+`initialize_episode`. Demonstrators read those facts and the public simulator state (model, data, the robot), never
+the task's attributes or body names of their own.
 """
 
 from __future__ import annotations
 
 import abc
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import mujoco
@@ -23,6 +30,27 @@ MAX_SUCCESS_SPEED_M_S = 1.0
 # `evaluate` reports measured quantities to the millimetre (mm/s): bit-level differences between runs of the same
 # episode (a policy's arithmetic in another process, say) stay out of the episode log. Decisions use exact values.
 MEASURE_DECIMALS = 3
+
+
+@dataclass(frozen=True)
+class EpisodeFacts:
+    """What a task tells its scripted demonstrator about the current episode, taken right after
+    `initialize_episode` and fixed until the next one (privileged knowledge, as a person who set up the scene has).
+
+    Body names are the world model's (`model.body(name)`); their poses come from the simulator state. Positions are
+    in the world frame (x forward, y left, z up; table top at z = 1.0), in m; angles in rad. Subclasses add the
+    facts of one task.
+    """
+
+    props: tuple[str, ...]  # the free bodies of the scene (`Task.props`, off-stage ones included), in that order
+    succeeds: Callable[[mujoco.MjData], bool]  # the task's success rule on any state of this world (imagined ones)
+
+
+@dataclass(frozen=True)
+class TargetFacts(EpisodeFacts):
+    """The facts of a task with one prop to pick."""
+
+    target: str  # body name of the prop to pick (a free body; its origin is its centre)
 
 
 class Task(abc.ABC):
@@ -69,6 +97,11 @@ class Task(abc.ABC):
         """Names of the free bodies whose motion must die down before the first observation."""
         return ()
 
+    def episode_facts(self) -> EpisodeFacts:
+        """What the demonstrator may know of this episode (see `EpisodeFacts`); called once after each
+        `initialize_episode`. Tasks with a demonstrator return their own subclass."""
+        return EpisodeFacts(props=self.props(), succeeds=self.is_success)
+
 
 class YcbTask(Task, abc.ABC):
     """A task with the five YCB objects (those not used in an episode wait off-stage) and one target prop."""
@@ -88,6 +121,9 @@ class YcbTask(Task, abc.ABC):
 
     def props(self) -> tuple[str, ...]:
         return OBJECT_NAMES
+
+    def episode_facts(self) -> TargetFacts:
+        return TargetFacts(props=self.props(), succeeds=self.is_success, target=self.target)
 
     def evaluate(self, data: mujoco.MjData) -> dict[str, bool | float]:
         return lift_conditions(self._model, data, self.target, self.success_height_m)

@@ -10,7 +10,7 @@ import numpy as np
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES, add_marker
 from lerobot_tavis.envs.scene import TABLE_TOP_Z, Look, use_look
-from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.base import TargetFacts, YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 from lerobot_tavis.envs.tasks.layout import Box2D
 
@@ -27,6 +27,15 @@ class ConditionalVariant:
     left_zone: Box2D  # robot's left = +y
     right_zone: Box2D
     card_zone: Box2D
+
+
+@dataclass(frozen=True)
+class ConditionalPickFacts(TargetFacts):
+    """`target` is `left_object` if the card is red, `right_object` if green."""
+
+    left_object: str  # body name of the object on the robot's left (+y)
+    right_object: str  # body name of the object on the robot's right (-y)
+    cue_card: str  # body name of the card lying flat on the table (a mocap body; its origin is its centre)
 
 
 class ConditionalPick(YcbTask):
@@ -64,3 +73,7 @@ class ConditionalPick(YcbTask):
         x, y = self.variant.card_zone.sample(rng)
         placement.set_mocap_pose(model, data, CARD, (x, y, TABLE_TOP_Z + CARD_SIZE_M[2] / 2 + 0.0005))
         model.geom_rgba[self._card_geom] = RED if self.card_is_red else GREEN
+
+    def episode_facts(self) -> ConditionalPickFacts:
+        return ConditionalPickFacts(props=self.props(), succeeds=self.is_success, target=self.target,
+                                    left_object=self.left_object, right_object=self.right_object, cue_card=CARD)

@@ -13,7 +13,7 @@ import numpy as np
 
 from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES
-from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.base import TargetFacts, YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 from lerobot_tavis.envs.tasks.layout import Box2D
 
@@ -32,6 +32,14 @@ SCREEN_PARTS = {
 @dataclass(frozen=True)
 class OccludedVariant:
     object_zone: Box2D
+
+
+@dataclass(frozen=True)
+class OccludedReachFacts(TargetFacts):
+    """The screen stands across the table in front of the target, centred on y = 0; its panel spans z 1.12-1.52 m."""
+
+    screen_x_m: float  # world x of the screen's plane
+    panel_half_width_m: float  # half the panel's width along y
 
 
 class OccludedReach(YcbTask):
@@ -55,3 +63,7 @@ class OccludedReach(YcbTask):
         x, y = self.variant.object_zone.sample(rng)
         placement.place_on_table(model, data, self.target, x, y, rng.uniform(-np.pi, np.pi))
         placement.hide(model, data, [n for n in OBJECT_NAMES if n != self.target])
+
+    def episode_facts(self) -> OccludedReachFacts:
+        return OccludedReachFacts(props=self.props(), succeeds=self.is_success, target=self.target,
+                                  screen_x_m=SCREEN_X, panel_half_width_m=PANEL_HALF_WIDTH)

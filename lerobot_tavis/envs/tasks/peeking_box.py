@@ -13,7 +13,7 @@ import numpy as np
 
 from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
-from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.base import TargetFacts, YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 from lerobot_tavis.envs.transforms import axis_angle_quat, matrix_from_quat
 
@@ -43,6 +43,49 @@ class BoxVariant:
     object_dy: tuple[float, float]
 
 
+def box_rotation(yaw_rad: float) -> np.ndarray:
+    """2x2 rotation (about z) from the frame of a box turned by `yaw_rad` to the world frame."""
+    return matrix_from_quat(axis_angle_quat((0, 0, 1), yaw_rad))[:2, :2]
+
+
+def box_point(center_xy, yaw_rad: float, dx: float, dy: float, z: float) -> np.ndarray:
+    """World point (m) at offset (dx, dy) from the box centre `center_xy` along the box's axes, at height z."""
+    return np.array([*(np.asarray(center_xy) + box_rotation(yaw_rad) @ (dx, dy)), z])
+
+
+@dataclass(frozen=True)
+class PeekingBoxFacts(TargetFacts):
+    """The box and its opening. Box frame: origin at the box's centre on the table, x from its front wall (facing
+    the robot) to its back wall, y toward its +y side, turned by `yaw_rad` about world z. Sizes are of the inside."""
+
+    open_side: str  # "+y" or "-y": the side without a wall, in the box frame
+    center_xy: tuple[float, float]  # world x, y of the box's centre, m
+    yaw_rad: float  # the box frame's turn about world z
+    half_depth_m: float  # half the inside along the box's x
+    half_width_m: float  # half the inside along the box's y
+    height_m: float  # inside height
+    wall_m: float  # wall thickness
+    bottom_z_m: float  # world z of the inside's bottom (sunk a little into the table)
+
+    @property
+    def top_z_m(self) -> float:
+        """World z of the inside's top (the lid's underside)."""
+        return self.bottom_z_m + self.height_m
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """2x2 rotation (about z) from the box frame to the world frame."""
+        return box_rotation(self.yaw_rad)
+
+    def point(self, dx: float, dy: float, z: float) -> np.ndarray:
+        """World point (m) at offset (dx, dy) from the box centre along the box's axes, at height z."""
+        return box_point(self.center_xy, self.yaw_rad, dx, dy, z)
+
+    def to_box(self, xy) -> np.ndarray:
+        """A world point's x, y (m) in the box frame."""
+        return self.rotation.T @ (np.asarray(xy) - np.asarray(self.center_xy))
+
+
 class PeekingBox(YcbTask):
     info = TASKS["peeking_box"]
     success_height_m = 1.25
@@ -61,11 +104,11 @@ class PeekingBox(YcbTask):
     @property
     def box_rotation(self) -> np.ndarray:
         """2x2 rotation (about z) from the box frame to the world frame."""
-        return matrix_from_quat(axis_angle_quat((0, 0, 1), self.box_yaw))[:2, :2]
+        return box_rotation(self.box_yaw)
 
     def box_point(self, dx: float, dy: float, z: float) -> np.ndarray:
         """World point (m) at offset (dx, dy) from the box centre along the box's axes, at height z."""
-        return np.array([*(self.box_center + self.box_rotation @ (dx, dy)), z])
+        return box_point(self.box_center, self.box_yaw, dx, dy, z)
 
     def build(self, spec) -> None:
         super().build(spec)
@@ -101,3 +144,8 @@ class PeekingBox(YcbTask):
         placement.place_on_table(model, data, self.target, x, y, self.box_yaw + yaw)
         placement.hide(model, data, [n for n in OBJECT_NAMES if n != self.target])
 
+    def episode_facts(self) -> PeekingBoxFacts:
+        return PeekingBoxFacts(props=self.props(), succeeds=self.is_success, target=self.target,
+                               open_side=self.open_side, center_xy=tuple(self.box_center.tolist()),
+                               yaw_rad=self.box_yaw, half_depth_m=HALF_DEPTH, half_width_m=HALF_WIDTH, height_m=HEIGHT,
+                               wall_m=WALL, bottom_z_m=BOTTOM_Z)

@@ -6,6 +6,7 @@ light is green, and fires at once if the object is already held up when it turns
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -15,7 +16,7 @@ from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES, add_marker
 from lerobot_tavis.envs.physics import POLICY_HZ
 from lerobot_tavis.envs.scene import TABLE_TOP_Z, Look, use_look
-from lerobot_tavis.envs.tasks.base import YcbTask
+from lerobot_tavis.envs.tasks.base import TargetFacts, YcbTask
 from lerobot_tavis.envs.tasks.catalog import TASKS
 from lerobot_tavis.envs.tasks.layout import Box2D
 
@@ -32,6 +33,15 @@ class WaitVariant:
     object_zone: Box2D
     light_zone: Box2D
     delay_range_s: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class WaitThenActFacts(TargetFacts):
+    """The light starts red and turns green after a drawn delay; lifting the target counts only once it is green."""
+
+    light: str  # body name of the signal light standing on the table (a mocap body; its origin is the lamp's centre)
+    # whether the light shows green now (what someone watching it sees); the one fact that changes in an episode
+    light_is_green: Callable[[], bool]
 
 
 class WaitThenAct(YcbTask):
@@ -71,6 +81,10 @@ class WaitThenAct(YcbTask):
     def after_step(self, model, data, elapsed_s: float) -> None:
         if not self.is_green and elapsed_s >= self.green_at_s - 1e-9:
             self._set_green(model, True)
+
+    def episode_facts(self) -> WaitThenActFacts:
+        return WaitThenActFacts(props=self.props(), succeeds=self.is_success, target=self.target, light=LIGHT,
+                                light_is_green=lambda: self.is_green)
 
     def task_state(self) -> np.ndarray:
         return np.array([float(self.is_green)])
