@@ -14,3 +14,13 @@ def test_wilson_edge_cases():
     assert wilson_interval(0, 0) == (0.0, 0.0)
     with pytest.raises(ValueError, match="successes must be within"):
         wilson_interval(5, 4)
+
+
+def test_wilson_bounds_contain_the_rate_at_all_or_nothing():
+    """Found by a protocol run whose report plot crashed: 6/6 gave an upper bound a hair below 1.0, so the error bar
+    had a negative length."""
+    for n in range(1, 200):
+        low, high = wilson_interval(n, n)
+        assert low <= 1.0 == high, n
+        low, high = wilson_interval(0, n)
+        assert low == 0.0 <= high, n
