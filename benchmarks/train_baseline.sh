@@ -12,13 +12,14 @@
 #
 # - cell: the whole cell within one 30-minute GPU slot: data, then training stopped after TRAIN_S seconds (780)
 #   with BATCH 128 and SAVE_FREQ 1500 unless set (loaders: WORKERS - 2), the checkpoints evaluated at low CPU
-#   priority as they appear, and those left after training ends.
+#   priority as they appear, and those left after training ends side by side.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
 #   libraries can be found (PyAV's bundled copy, tools/pyav_ffmpeg.sh), else with PyAV.
-# - eval: lerobot-eval on every complete checkpoint not yet evaluated (seeds from 1000), then `tavis report`; it
-#   can run beside `train`, which marks a checkpoint complete by pointing `checkpoints/last` at it.
+# - eval: lerobot-eval on every complete checkpoint not yet evaluated (seeds from 1000), side by side, then
+#   `tavis report`; it can run beside `train`, which marks a checkpoint complete by pointing `checkpoints/last` at
+#   it, and beside another `eval` call, which skips the checkpoints that one is evaluating.
 # - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (3000) and
 #   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
 #   on points at a data or alignment bug, not at too little training.
@@ -74,11 +75,13 @@ case "${1:-}" in
     ( BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1500} STEPS=${STEPS:-1000000} \
         WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-780}" "$0" train || true
       touch "$stopped" ) &
-    while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
-      nice -n 15 "$0" eval
-      sleep 10
-    done
-    "$0" eval
+    ( while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
+        nice -n 15 "$0" eval
+        sleep 10
+      done ) &
+    while [ ! -f "$stopped" ]; do sleep 5; done
+    "$0" eval  # the checkpoints left, side by side with the one still being evaluated
+    wait
     ;;
   data)
     [ -f "$WORK/raw/manifest.json" ] || time tavis record --robot "$ROBOT" --tasks "$TASK" \
@@ -96,8 +99,12 @@ case "${1:-}" in
     for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
       (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
       out="$WORK/eval_$CONDITION/step_$((10#$(basename "$checkpoint")))"
-      [ -f "$out/eval_info.json" ] || time evaluate "$checkpoint" "$out" 1000 "$EVAL_EPISODES"
+      [ -f "$out/eval_info.json" ] && continue
+      mkdir -p "$(dirname "$out")"
+      mkdir "$out.running" 2>/dev/null || continue  # another eval call has it
+      ( trap 'rmdir "$out.running"' EXIT; time evaluate "$checkpoint" "$out" 1000 "$EVAL_EPISODES" ) &
     done
+    wait
     ;;
   overfit)
     choose_video_backend
