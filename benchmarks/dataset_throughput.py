@@ -24,7 +24,7 @@ def _size_mb(path: Path) -> float:
 
 def main() -> None:
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from lerobot_tavis.cli import _image_size
+    from lerobot_tavis.checks import image_size_text
     from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
     from lerobot_tavis.dataset_tools.features import parse_cameras
     from lerobot_tavis.dataset_tools.record import RecordConfig, record
@@ -42,14 +42,15 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as scratch:
         raw_dir, root = Path(scratch) / "raw", Path(scratch) / "dataset"
         start = time.perf_counter()
-        manifest = record(RecordConfig(raw_dir, args.robot, suite_tasks(args.suite), args.episodes_per_task,
-                                       workers=args.workers), progress=False)
+        manifest = record(RecordConfig(out_dir=raw_dir, robot=args.robot, tasks=suite_tasks(args.suite),
+                                       episodes_per_task=args.episodes_per_task, workers=args.workers),
+                          progress=False)
         record_s = time.perf_counter() - start
         tried = len(manifest.episodes) + len(manifest.discarded)
         steps = sum(e.n_steps for e in manifest.episodes + manifest.discarded)
 
         start = time.perf_counter()
-        convert(ConvertConfig(raw_dir, "local/throughput", root, image_size=_image_size(args.image_size),
+        convert(ConvertConfig(raw_dir, "local/throughput", root, image_size=image_size_text(args.image_size),
                               cameras=parse_cameras(args.cameras)), progress=False)
         convert_s = time.perf_counter() - start
         frames = sum(-(-e.n_steps // 3) for e in manifest.episodes)

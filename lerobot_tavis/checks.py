@@ -43,6 +43,15 @@ def image_size(value, field: str = "image_size") -> tuple[int, int]:
     return height, width
 
 
+def image_size_text(text: str, field: str = "image_size") -> tuple[int, int]:
+    """`480x640` (height x width, pixels) -> (480, 640), as the command line writes a size; `image_size` checks
+    the range."""
+    match = re.fullmatch(r"\s*([0-9]+)\s*[xX]\s*([0-9]+)\s*", text)
+    if not match or not all(int(side) > 0 for side in match.groups()):
+        raise FieldError(field, f"must be HxW in pixels, e.g. 480x640 (height x width), got {text!r}")
+    return int(match[1]), int(match[2])
+
+
 def episode_steps(episode_length_s, fps: int, field: str = "episode_length_s") -> int:
     """Steps of an episode of `episode_length_s` seconds at `fps`; refused unless finite and at least one step."""
     if _is_real(episode_length_s) and math.isfinite(episode_length_s * fps) and round(episode_length_s * fps) >= 1:

@@ -7,23 +7,24 @@ hand events GALT finds in the episode (`lerobot_tavis.overlay`), and prints whet
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
 from lerobot_tavis import checks
+from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_NAMES
 from lerobot_tavis.envs.robots import robot_names
-from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_info
 from lerobot_tavis.experts.registry import make_expert
 from lerobot_tavis.media import write_mp4
 from lerobot_tavis.metrics.galt import compute_galt
 from lerobot_tavis.overlay import Caption, EpisodeEvents, redraw_caption
 
 FPS = 20
-TASKS = BENCHMARK_TASKS
 
 
 def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) -> tuple[list[np.ndarray], bool]:
@@ -49,15 +50,29 @@ def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) 
     return frames, success
 
 
-def run_demo(out_dir: str | Path, robots=None, tasks=TASKS, image_size=(240, 320), seed: int = 0) -> list[Path]:
-    """Film every task of `tasks` on every robot of `robots` (default: every registered robot)."""
-    checks.integer("seed", seed, 0)
-    robots = robot_names() if robots is None else robots
-    out_dir = Path(out_dir)
+@dataclass(frozen=True)
+class DemoConfig:
+    """What `tavis demo` films, and where; also its command-line options."""
+
+    out_dir: Path = option(Path("outputs/demo"), "output directory (default: outputs/demo)", flag="--out")
+    robots: tuple[str, ...] = option(default_factory=lambda: tuple(robot_names()), choices=robot_names)
+    tasks: tuple[str, ...] = option(BENCHMARK_TASKS, "task names (default: the eight TAVIS tasks)")
+    image_size: tuple[int, int] = option((240, 320), "HxW of every camera (default 240x320)",
+                                         parse=checks.image_size_text)
+    seed: int = 0
+
+    def __post_init__(self):
+        checks.integer("seed", self.seed, 0)
+        for task in self.tasks:
+            task_info(task, "tasks")
+
+
+def run_demo(cfg: DemoConfig) -> list[Path]:
+    """Film every task of `cfg.tasks` on every robot of `cfg.robots`."""
     written = []
-    for robot in robots:
-        for task in tqdm(tasks, desc=f"demo {robot}", unit="task"):
-            frames, success = film_episode(task, robot, image_size, seed)
-            written.append(write_mp4(out_dir / robot / f"{task}.mp4", frames, FPS))
+    for robot in cfg.robots:
+        for task in tqdm(cfg.tasks, desc=f"demo {robot}", unit="task"):
+            frames, success = film_episode(task, robot, cfg.image_size, cfg.seed)
+            written.append(write_mp4(Path(cfg.out_dir) / robot / f"{task}.mp4", frames, FPS))
             tqdm.write(f"{robot} {task}: {'success' if success else 'failure'} in {len(frames) - 1 - FPS} steps")
     return written

@@ -21,6 +21,7 @@ import numpy as np
 from tqdm import tqdm
 
 from lerobot_tavis import canonical, checks
+from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import BUILTIN_ROBOTS, DEFAULT_ROBOT, robot_info, robot_names
@@ -140,21 +141,32 @@ def overview_figure(stills: dict[str, Stills], portraits: dict[str, np.ndarray])
     ])
 
 
-def write_gallery(out_dir: str | Path, *, robots=None, tasks=BENCHMARK_TASKS, image_size=(240, 320),
-                  seed: int = 0, figure_robot: str = DEFAULT_ROBOT) -> list[Path]:
-    """Render every task sheet (`robots`: default every registered robot) and, when all eight tasks of
-    `figure_robot` are included, the overview figure."""
-    checks.integer("seed", seed, 0)
-    robots = robot_names() if robots is None else robots
-    out_dir = Path(out_dir)
+@dataclass(frozen=True)
+class GalleryConfig:
+    """What `tavis gallery` renders, and where; also its command-line options."""
+
+    out_dir: Path = option(Path("docs/images"), "output directory (default: docs/images)", flag="--out")
+    robots: tuple[str, ...] = option(default_factory=lambda: tuple(robot_names()), choices=robot_names)
+    tasks: tuple[str, ...] = option(BENCHMARK_TASKS, "default: the eight TAVIS tasks", choices=BENCHMARK_TASKS)
+    image_size: tuple[int, int] = option((240, 320), "HxW of every view (default 240x320)",
+                                         parse=checks.image_size_text)
+    seed: int = option(0, "episode seed of every task (default 0)")
+
+    def __post_init__(self):
+        checks.integer("seed", self.seed, 0)
+
+
+def write_gallery(cfg: GalleryConfig, figure_robot: str = DEFAULT_ROBOT) -> list[Path]:
+    """Render every task sheet and, when all eight tasks of `figure_robot` are included, the overview figure."""
+    out_dir = Path(cfg.out_dir)
     written, by_robot = [], {}
-    jobs = [(robot, task) for robot in robots for task in tasks]
+    jobs = [(robot, task) for robot in cfg.robots for task in cfg.tasks]
     for robot, task in tqdm(jobs, desc="gallery", unit="episode"):
-        stills = capture_stills(task, robot, image_size=image_size, seed=seed)
+        stills = capture_stills(task, robot, image_size=cfg.image_size, seed=cfg.seed)
         by_robot.setdefault(robot, {})[task] = stills
         written.append(write_png(out_dir / "gallery" / robot / f"{task}.png", task_sheet(stills)))
-    for robot in robots:
-        sheet = ood_visual_sheet(OOD_VISUAL_TASK, robot, image_size=image_size, seed=seed)
+    for robot in cfg.robots:
+        sheet = ood_visual_sheet(OOD_VISUAL_TASK, robot, image_size=cfg.image_size, seed=cfg.seed)
         written.append(write_png(out_dir / "gallery" / robot / "ood_visual.png", sheet))
     if figure_robot in by_robot and set(by_robot[figure_robot]) == set(BENCHMARK_TASKS):
         portraits = {robot: robot_portrait(robot) for robot in BUILTIN_ROBOTS}  # the benchmark's robots

@@ -32,8 +32,12 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_tavis import canonical, checks
+from lerobot_tavis.cli_options import option
+from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
+from lerobot_tavis.envs.tasks.catalog import split_names, task_names
 from lerobot_tavis.errors import TavisError
-from lerobot_tavis.viewer import KEY_BACKSPACE, KEY_DOWN, KEY_ENTER, KEY_LEFT, KEY_RIGHT, KEY_SPACE, KEY_TAB, KEY_UP
+from lerobot_tavis.viewer import (FREE_CAMERA, KEY_BACKSPACE, KEY_DOWN, KEY_ENTER, KEY_LEFT, KEY_RIGHT, KEY_SPACE,
+                                  KEY_TAB, KEY_UP, WINDOW_CAMERAS)
 
 HAND_STEP_M = 0.01
 HEAD_STEP_RAD = 0.05
@@ -119,17 +123,19 @@ def lerobot_gamepad():
     return controller
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class TeleopConfig:
-    out_dir: Path
-    task: str
-    robot: str = "gr1t2"
-    split: str = "id"
-    episodes: int = 1
-    seed_start: int = 200_000
-    keep_failures: bool = False
-    view: str = "head"  # a camera of the world ("head", "fixed", "overview", ...), or "free"
-    gamepad: bool = False  # also read LeRobot's gamepad controller
+    """What `tavis teleop` records, and where; also its command-line options."""
+
+    task: str = option(choices=task_names)
+    robot: str = option(DEFAULT_ROBOT, choices=robot_names)
+    split: str = option("id", choices=split_names)
+    episodes: int = option(1, "kept episodes to record (default 1)")
+    seed_start: int = option(200_000, "first seed (default 200000)")
+    keep_failures: bool = option(False, "keep episodes that did not succeed too")
+    view: str = option("head", "the window's camera (default head)", choices=WINDOW_CAMERAS)
+    gamepad: bool = option(False, "also drive the active hand with a gamepad (LeRobot's controller; needs pygame)")
+    out_dir: Path = option(help="raw directory, as `tavis record` writes; re-running adds to it", flag="--out")
 
     def __post_init__(self):
         checks.integer("episodes", self.episodes, 1)
@@ -182,7 +188,7 @@ def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
     try:
         if keys is None:
             env.reset(seed=seed)
-            window = Window(env, None if cfg.view == "free" else cfg.view)
+            window = Window(env, None if cfg.view == FREE_CAMERA else cfg.view)
             keys, show = window.keys, window.show
         while manifest.kept(cfg.task) < cfg.episodes and (window is None or window.running):
             ending, success, actions, states = teleop_episode(env, seed, keys, show, gamepad)

@@ -18,10 +18,16 @@ from pathlib import Path
 
 import numpy as np
 
+from lerobot_tavis.cli_options import option
+from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS
 from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
+from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
+from lerobot_tavis.envs.tasks.catalog import split_names, task_names
 from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError
 
 DRIVERS = ("demonstrator", "policy", "paused")
+FREE_CAMERA = "free"  # the window's camera moved with the mouse
+WINDOW_CAMERAS = (*CAMERA_NAMES, *VIEW_CAMERAS, FREE_CAMERA)  # what a window may look through
 # GLFW key codes, as the viewer's key callback passes them (letters and digits are their ASCII codes)
 KEY_SPACE, KEY_ENTER, KEY_TAB, KEY_BACKSPACE = 32, 257, 258, 259
 KEY_RIGHT, KEY_LEFT, KEY_DOWN, KEY_UP = 262, 263, 264, 265
@@ -122,15 +128,25 @@ class PolicyDriver:
 
 @dataclass(frozen=True)
 class ViewConfig:
-    task: str
-    robot: str | None = None  # None: the checkpoint's when a policy drives, else gr1t2
-    split: str = "id"
+    """The episode `tavis view` shows and who drives it; also its command-line options. `driver` None: the policy
+    when `policy` is given, else the demonstrator."""
+
+    task: str = option(choices=task_names)
+    robot: str | None = option(None, f"default: the checkpoint's, else {DEFAULT_ROBOT}", choices=robot_names)
+    split: str = option("id", choices=split_names)
     seed: int = 1000
-    driver: str = "demonstrator"
-    policy: str | None = None  # a checkpoint's pretrained_model folder, for driver "policy"
-    device: str = "cpu"
-    camera: str | None = None  # None: the free camera
-    max_frames: int | None = None  # stop after this many frames (tests, scripted demos); None: until closed
+    driver: str | None = option(None, "who acts (default: the policy when --policy is given, else the demonstrator)",
+                                choices=DRIVERS)
+    policy: str | None = option(None, "a checkpoint's pretrained_model folder; its camera mode and image size apply")
+    device: str = option("cpu", "the policy's device (default cpu)")
+    camera: str = option(FREE_CAMERA, "the window's camera (default: the free camera, moved with the mouse)",
+                         choices=WINDOW_CAMERAS)
+    # stop after this many frames (tests, scripted demos); None: until the window closes
+    max_frames: int | None = option(None, command_line=False)
+
+    def __post_init__(self):
+        if self.driver is None:
+            object.__setattr__(self, "driver", "policy" if self.policy else "demonstrator")
 
 
 def view(cfg: ViewConfig) -> int:
@@ -167,7 +183,7 @@ def view(cfg: ViewConfig) -> int:
         return observation, expert
 
     observation, expert = start()
-    window = Window(env, cfg.camera, rate_hz=fps)
+    window = Window(env, None if cfg.camera == FREE_CAMERA else cfg.camera, rate_hz=fps)
     try:
         while window.running and (cfg.max_frames is None or frames < cfg.max_frames):
             restart = False

@@ -2,11 +2,10 @@
 
 import pytest
 
-from lerobot_tavis.cli import EVAL_DEFAULTS
 from lerobot_tavis.envs.config import TavisEnvConfig
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_MODES, PAPER_CONDITIONS, resolve_camera_mode
-from lerobot_tavis.eval.protocol import ProtocolConfig
+from lerobot_tavis.eval.protocol import ENV_DEFAULTS, ProtocolConfig
 from lerobot_tavis.policy_configs import preset_path
 
 PAPER_HEADCAM = ("head", "left_wrist", "right_wrist")
@@ -22,8 +21,8 @@ def test_every_entry_point_defaults_to_the_papers_headcam_condition(tmp_path):
     config = TavisEnvConfig()
     assert config.camera_mode == "head_wrist"
     assert sorted(k for k in config.features if k.startswith("pixels/")) == sorted(f"pixels/{c}" for c in PAPER_HEADCAM)
-    assert ProtocolConfig(out_dir=tmp_path).camera_mode == "head_wrist"
-    assert EVAL_DEFAULTS["camera_mode"] == "head_wrist"  # tavis eval, when the checkpoint does not say otherwise
+    assert ProtocolConfig(out_dir=tmp_path, expert=True).camera_mode == "head_wrist"
+    assert ENV_DEFAULTS["camera_mode"] == "head_wrist"  # tavis eval, when the checkpoint does not say otherwise
 
 
 @pytest.mark.parametrize("old,new,cameras", [("headcam", "head_only", ("head",)),
@@ -37,7 +36,7 @@ def test_old_names_keep_their_meaning_with_a_deprecation_warning(old, new, camer
     with pytest.warns(FutureWarning, match=message):
         assert TavisEnvConfig(camera_mode=old).camera_mode == new
     with pytest.warns(FutureWarning, match=message):
-        assert ProtocolConfig(out_dir=tmp_path, camera_mode=old).camera_mode == new
+        assert ProtocolConfig(out_dir=tmp_path, expert=True, camera_mode=old).camera_mode == new
     with pytest.warns(FutureWarning, match=message):
         assert preset_path(f"diffusion_{old}").name == f"diffusion_{new}.json"
 

@@ -1,13 +1,13 @@
 import av
 import numpy as np
 
-from lerobot_tavis.demo import run_demo
+from lerobot_tavis.demo import DemoConfig, run_demo
 from lerobot_tavis.overlay import EVENT_COLOURS, PANEL_HEIGHT, band_height
 
 
 def test_demo_writes_an_annotated_video_per_task(tmp_path):
-    written = run_demo(tmp_path, robots=("gr1t2",), tasks=("wait_then_act", "blocked_clutter_pick_cube"),
-                       image_size=(32, 48))
+    written = run_demo(DemoConfig(tmp_path, robots=("gr1t2",), tasks=("wait_then_act", "blocked_clutter_pick_cube"),
+                                  image_size=(32, 48)))
     assert [p.name for p in written] == ["wait_then_act.mp4", "blocked_clutter_pick_cube.mp4"]
     with av.open(str(tmp_path / "gr1t2" / "blocked_clutter_pick_cube.mp4")) as video:
         frames = [f.to_ndarray(format="rgb24") for f in video.decode(video=0)]

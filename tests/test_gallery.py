@@ -1,12 +1,13 @@
 import numpy as np
 
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, VISUAL_FACTORS
-from lerobot_tavis.gallery import (OOD_VISUAL_VIEWS, SHEET_VIEWS, Stills, capture_stills, ood_visual_sheet,
-                                   overview_figure, write_gallery)
+from lerobot_tavis.gallery import (OOD_VISUAL_VIEWS, SHEET_VIEWS, GalleryConfig, Stills, capture_stills,
+                                   ood_visual_sheet, overview_figure, write_gallery)
 
 
 def test_task_sheet_shows_the_first_observation_and_the_grasp(tmp_path):
-    written = write_gallery(tmp_path, robots=("gr1t2",), tasks=("conditional_pick",), image_size=(48, 64))
+    written = write_gallery(GalleryConfig(tmp_path, robots=("gr1t2",), tasks=("conditional_pick",),
+                                          image_size=(48, 64)))
     assert [p.relative_to(tmp_path).as_posix() for p in written] == ["gallery/gr1t2/conditional_pick.png",
                                                                      "gallery/gr1t2/ood_visual.png"]
     assert not (tmp_path / "overview.png").exists()  # the figure needs all eight tasks

@@ -26,7 +26,8 @@ SMALL_RUN = ["--env.task=conditional_pick", f"--env.image_size=[{TINY[0]},{TINY[
 def dataset_root(tmp_path_factory):
     """One conditional_pick demonstration converted with all four cameras at 48x64."""
     scratch = tmp_path_factory.mktemp("presets")
-    record(RecordConfig(scratch / "raw", "gr1t2", ("conditional_pick",), 1), progress=False)
+    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",),
+                        episodes_per_task=1), progress=False)
     return convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=TINY), progress=False)
 
 

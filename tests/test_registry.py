@@ -16,6 +16,7 @@ import pytest
 
 from lerobot_tavis import canonical, registry
 from lerobot_tavis.cli import build_parser
+from lerobot_tavis.cli_options import from_args
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import RED_CUBE, add_prop
 from lerobot_tavis.envs.robots.gr1t2 import GR1T2
@@ -163,7 +164,8 @@ def test_registered_names_reach_the_config_the_cli_and_suite_expansion(toys):
     args = build_parser().parse_args(["eval", "--expert", "--robot", "toy_gr1t2", "--camera-mode", TOY_MODE,
                                       "--out", "unused"])
     assert (args.robot, args.camera_mode) == ("toy_gr1t2", TOY_MODE)
-    assert "toy_gr1t2" in build_parser().parse_args(["demo"]).robots
+    demo = build_parser().parse_args(["demo"])
+    assert "toy_gr1t2" in from_args(demo.options, demo).robots  # the default: every registered robot
     view = build_parser().parse_args(["view", "--task", "toy_lift_cube", "--robot", "toy_gr1t2"])
     assert (view.task, view.robot) == ("toy_lift_cube", "toy_gr1t2")
 

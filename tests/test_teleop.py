@@ -54,7 +54,7 @@ def test_recorded_episodes_are_raw_episodes_that_convert_reads(tmp_path):
     presses = {5: [KEY_BACKSPACE]}
     presses.update({6 + t: [ord("W"), ord("Q"), KEY_DOWN] for t in range(0, 30, 3)})
     presses[6 + 60] = [KEY_ENTER]
-    cfg = TeleopConfig(tmp_path / "raw", "conditional_pick", episodes=1, keep_failures=True)
+    cfg = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=1, keep_failures=True)
     outcomes = teleop(cfg, keys=scripted(presses), show=lambda: None)
     assert outcomes == ["seed 200000: dropped", "seed 200001: failure, kept (60 steps)"]
 
@@ -75,9 +75,9 @@ def test_recorded_episodes_are_raw_episodes_that_convert_reads(tmp_path):
 
 
 def test_a_rerun_continues_with_the_next_seed(tmp_path):
-    cfg = TeleopConfig(tmp_path / "raw", "conditional_pick", episodes=1, keep_failures=True)
+    cfg = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=1, keep_failures=True)
     teleop(cfg, keys=scripted({3: [KEY_ENTER]}), show=lambda: None)
-    more = TeleopConfig(tmp_path / "raw", "conditional_pick", episodes=2, keep_failures=True)
+    more = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=2, keep_failures=True)
     assert teleop(more, keys=scripted({3: [KEY_ENTER]}), show=lambda: None) == [
         "seed 200001: failure, kept (3 steps)"]
 
@@ -88,7 +88,7 @@ def test_without_a_display_it_says_how_to_get_one(tmp_path, monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     with pytest.raises(NoDisplayError, match="xvfb-run -a tavis teleop"):
-        teleop(TeleopConfig(tmp_path / "raw", "conditional_pick"))
+        teleop(TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick"))
     assert not (tmp_path / "raw").exists()
 
 
@@ -120,7 +120,7 @@ def test_a_gamepad_moves_the_active_hand_closes_its_gripper_and_ends_the_episode
     ticks = [((0.001, 0.0, 0.002), "stay", None)] * 30 + [((0.0, 0.0, 0.0), "close", None)] * 5
     ticks += [((0.0, 0.0, 0.0), "stay", TeleopEvents.FAILURE)]
     gamepad = ScriptedGamepad(ticks)
-    cfg = TeleopConfig(tmp_path / "raw", "conditional_pick", episodes=1, keep_failures=True)
+    cfg = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=1, keep_failures=True)
     assert teleop(cfg, keys=scripted({0: [KEY_TAB]}), show=lambda: None, gamepad=gamepad) == [
         "seed 200000: failure, kept (35 steps)"]
     assert gamepad.stopped

@@ -81,7 +81,8 @@ def act_checkpoint(tmp_path_factory):
     from lerobot_tavis.policy_configs import preset_path
 
     scratch = tmp_path_factory.mktemp("view_policy")
-    record(RecordConfig(scratch / "raw", "gr1t2", ("conditional_pick",), 1), progress=False)
+    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",),
+                        episodes_per_task=1), progress=False)
     root = convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=(120, 160),
                                  cameras=("head", "left_wrist", "right_wrist")), progress=False)
     train = [sys.executable, "-m", "lerobot.scripts.lerobot_train",

@@ -27,6 +27,7 @@ import numpy as np
 from tqdm import tqdm
 
 from lerobot_tavis import canonical, checks
+from lerobot_tavis.cli_options import option
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
 from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
@@ -36,6 +37,7 @@ from lerobot_tavis.envs.tasks.catalog import task_sort_key
 from lerobot_tavis.errors import InputError, TavisError
 
 CONVERSION_LOG = "meta/tavis_conversion.json"
+RAW_IMAGE_SIZE = (480, 640)  # (H, W) of the cameras rendered from raw episodes unless told otherwise
 
 
 class ReplayError(TavisError):
@@ -44,26 +46,47 @@ class ReplayError(TavisError):
 
 @dataclass(frozen=True)
 class ConvertConfig:
-    raw_dir: Path
-    repo_id: str
-    root: Path
-    fps: int = 20
-    image_size: tuple[int, int] = (480, 640)
-    cameras: tuple[str, ...] = ft.CAMERAS
-    task: str | None = None
-    overwrite: bool = False
-    zero_neck: bool = False  # neck dims of state and action set to 0: fixed-camera training (reference §9)
-    storage: str = "av1"  # how frames are stored: features.STORAGES
-    workers: int = 1  # replaying processes
+    """What `tavis convert` converts, and how; also its command-line options. The source is `raw_dir` (a `tavis
+    record` output) or `from_tavis` (an original TAVIS dataset, `dataset_tools.from_tavis`), exactly one; the
+    storage, neck and worker settings apply to raw episodes only. `image_size` None: RAW_IMAGE_SIZE for raw
+    episodes, the source size for an original dataset."""
+
+    raw_dir: Path | None = option(help="a `tavis record` output directory", positional=True)
+    from_tavis: Path | None = option(None, "convert an original TAVIS dataset (60 Hz) instead", metavar="ROOT",
+                                     kw_only=True)
+    repo_id: str = option(help="dataset id, e.g. <user>/tavis-head-gr1t2")
+    root: Path = option(help="destination directory (must not exist unless --overwrite)")
+    fps: int = option(20, "dataset rate; must divide 60 (default 20)")
+    image_size: tuple[int, int] | None = option(None, "HxW of every camera (default 480x640; --from-tavis: the "
+                                                "source size)", parse=checks.image_size_text)
+    cameras: tuple[str, ...] = option(ft.CAMERAS, "comma list of cameras", parse=ft.parse_cameras)
+    task: str | None = option(None, "convert only this task")
+    overwrite: bool = option(False, "replace an existing destination")
+    storage: str = option("av1", "camera frames as AV1 video (LeRobot's default, smallest), all-intra H.264 video "
+                          "(fast random access for training) or PNG images (no video decoding; largest)",
+                          choices=ft.STORAGES)
+    zero_neck: bool = option(False, "neck dims of state and action = 0 (datasets for the fixed-camera presets)")
+    workers: int = option(1, "processes replaying and rendering episodes (the dataset does not depend on it)")
 
     def __post_init__(self):
+        if (self.raw_dir is None) == (self.from_tavis is None):
+            raise InputError("give exactly one of RAW_DIR (a `tavis record` output) and --from-tavis ROOT")
+        if self.from_tavis is not None and (self.zero_neck or self.storage != "av1"):
+            raise InputError("--zero-neck and --storage apply to raw episodes, not to --from-tavis")
         checks.repo_id(self.repo_id)
-        checks.image_size(self.image_size)
-        checks.integer("workers", self.workers, 1)
+        if self.raw_dir is not None:
+            object.__setattr__(self, "image_size", checks.image_size(
+                RAW_IMAGE_SIZE if self.image_size is None else self.image_size))
+            checks.integer("workers", self.workers, 1)
 
 
 def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
-    """Convert `cfg.raw_dir` into a LeRobotDataset at `cfg.root`; returns the root."""
+    """Convert `cfg.raw_dir` (or `cfg.from_tavis`) into a LeRobotDataset at `cfg.root`; returns the root."""
+    if cfg.from_tavis is not None:
+        from lerobot_tavis.dataset_tools.from_tavis import convert_from_tavis
+
+        return convert_from_tavis(cfg.from_tavis, cfg.repo_id, cfg.root, fps=cfg.fps, image_size=cfg.image_size,
+                                  overwrite=cfg.overwrite, task=cfg.task, progress=progress)
     os.environ.setdefault("MUJOCO_GL", "egl")
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 

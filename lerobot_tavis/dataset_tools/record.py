@@ -20,33 +20,41 @@ import numpy as np
 from tqdm import tqdm
 
 from lerobot_tavis import canonical, checks
+from lerobot_tavis.cli_options import option
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
 from lerobot_tavis.dataset_tools.workers import BACKENDS, executor
+from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
+from lerobot_tavis.envs.tasks.catalog import SUITES, expand_tasks, split_names
 from lerobot_tavis.errors import FieldError, InputError
 
 RECORD_FPS = 60
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class RecordConfig:
-    out_dir: Path
-    robot: str
-    tasks: tuple[str, ...]
-    episodes_per_task: int
-    split: str = "id"
-    keep_failures: bool = False
-    seed_start: int = 100_000
-    workers: int = 1  # episodes in flight at once (local backend: worker processes)
-    max_attempts_factor: float = 3.0
-    backend: str = "local"  # or "ray" (dataset_tools.workers)
+    """What `tavis record` records; also its command-line options. `tasks` (task or suite names) default to every
+    task of `suite`, and hold the task names after construction."""
+
+    robot: str = option(DEFAULT_ROBOT, choices=robot_names)
+    suite: str = option(SUITES[0], choices=SUITES)
+    tasks: tuple[str, ...] = option((), "task names (default: every task of --suite)")
+    split: str = option("id", choices=split_names)
+    episodes_per_task: int = option(160, "kept episodes per task (default 160)")
+    keep_failures: bool = option(False, "keep failed episodes too (default: discard)")
+    seed_start: int = option(100_000, "first seed (evaluation uses 1000..)")
+    workers: int = option(1, "episodes at once (local backend: processes)")
+    backend: str = option("local", "local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)",
+                          choices=BACKENDS)
+    out_dir: Path = option(help="raw directory; re-running resumes it", flag="--out")
+    max_attempts_factor: float = option(3.0, command_line=False)
 
     def __post_init__(self):
+        groups = expand_tasks(",".join(self.tasks or (self.suite,)), "tasks")
+        object.__setattr__(self, "tasks", tuple(task for tasks in groups.values() for task in tasks))
         checks.integer("episodes_per_task", self.episodes_per_task, 1)
         checks.integer("workers", self.workers, 1)
         checks.integer("seed_start", self.seed_start, 0)
         checks.choice("backend", self.backend, BACKENDS)
-        if not self.tasks:
-            raise FieldError("tasks", "must name at least one task")
 
     @property
     def max_attempts(self) -> int:

@@ -15,10 +15,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis import checks
+from lerobot_tavis.cli_options import option
 from lerobot_tavis.dataset_tools.workers import BACKENDS
-from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, resolve_camera_mode
+from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, RENAMED_MODES, camera_mode_names, resolve_camera_mode
 from lerobot_tavis.envs.physics import POLICY_HZ
-from lerobot_tavis.errors import InputError
+from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
+from lerobot_tavis.envs.tasks.catalog import PROTOCOL_SPLITS, SUITES, split_names
+from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.eval.cell_runs import policy_config, run_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
@@ -35,26 +38,66 @@ class Cell:
         return f"{self.suite}__{self.split}"
 
 
-@dataclass(frozen=True)
+def policy_options(texts: tuple[str, ...]) -> tuple[tuple[str, object], ...]:
+    """("num_inference_steps=10", ...) -> (("num_inference_steps", 10), ...): values are read as JSON, else kept as
+    text."""
+    options = []
+    for text in texts:
+        name, sign, value = text.partition("=")
+        if not (sign and name.strip()):
+            raise FieldError("policy_options", f"must be FIELD=VALUE, e.g. num_inference_steps=10, got {text!r}")
+        try:
+            options.append((name.strip(), json.loads(value)))
+        except json.JSONDecodeError:
+            options.append((name.strip(), value))
+    return tuple(options)
+
+
+# The env settings of a run when neither the config nor the policy checkpoint's training config gives them.
+ENV_DEFAULTS = {"robot": DEFAULT_ROBOT, "camera_mode": DEFAULT_CAMERA_MODE, "image_size": (480, 640)}
+
+
+@dataclass(frozen=True, kw_only=True)
 class ProtocolConfig:
-    out_dir: Path
-    robot: str = "gr1t2"
-    suites: tuple[str, ...] = ("tavis_head",)
-    splits: tuple[str, ...] = ("id", "ood_spatial", "ood_init_pose")
-    n_episodes: int = 96
-    camera_mode: str = DEFAULT_CAMERA_MODE
-    image_size: tuple[int, int] = (480, 640)
-    episode_length_s: float = 20.0
-    policy_path: str | None = None  # None: the scripted demonstrators
-    batch_size: int = 1
+    """The protocol run of `tavis eval`; also its command-line options. Exactly one of `policy_path` and `expert`;
+    `robot`, `camera_mode` and `image_size` left None are the checkpoint's, else ENV_DEFAULTS."""
+
+    policy_path: str | None = option(None, "policy checkpoint directory (pretrained_model)", flag="--policy")
+    expert: bool = option(False, "evaluate the scripted demonstrators instead")
+    robot: str | None = option(None, f"default: the checkpoint's, else {DEFAULT_ROBOT}", choices=robot_names)
+    suites: tuple[str, ...] = option(SUITES[:1], flag="--suite", choices=SUITES)
+    splits: tuple[str, ...] = option(PROTOCOL_SPLITS, "default: the reference's id ood_spatial ood_init_pose; also "
+                                     "ood_visual (the look changed) and ood_visual:<factor> for one factor alone",
+                                     choices=split_names)
+    n_episodes: int = option(96, "episodes per task and split (default 96)", flag="--episodes")
+    camera_mode: str | None = option(None, "default: the checkpoint's, else head_wrist; head_wrist and fixed_wrist "
+                                     "are the paper's headcam and fixedcam conditions",
+                                     choices=lambda: [*camera_mode_names(), *RENAMED_MODES])
+    image_size: tuple[int, int] | None = option(None, "HxW; default: the checkpoint's, else 480x640",
+                                                parse=checks.image_size_text)
+    batch_size: int = option(1, "parallel envs per task (policy runs)")
     device: str = "cpu"
-    workers: int = 1  # (cell, task, seed chunk) jobs at once: local processes, or sharers of one GPU under Ray
-    seed: int = START_SEED
-    chunk_episodes: int | None = None  # consecutive seeds per job; default 8 (demonstrators), 96 (policies)
-    policy_options: tuple[tuple[str, object], ...] = ()  # (field, value) set on the checkpoint's policy config
-    backend: str = "local"  # or "ray" (dataset_tools.workers)
+    episode_length_s: float = option(20.0, "seconds per episode (default 20)")
+    policy_options: tuple[tuple[str, object], ...] = option(  # (field, value) set on the checkpoint's policy config
+        (), "set a field of the checkpoint's policy config, e.g. num_inference_steps=10 or use_amp=true (repeatable)",
+        flag="--policy-option", action="append", metavar="FIELD=VALUE", parse=policy_options)
+    workers: int = option(1, "(cell, task, seed chunk) jobs at once; with a policy on a GPU they share it")
+    chunk_episodes: int | None = option(None, "consecutive episodes per job, also what a killed run loses at most "
+                                        "(default 8 for the demonstrators, 96 for a policy: each policy job starts "
+                                        "a lerobot-eval run)")
+    backend: str = option("local", "local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)",
+                          choices=BACKENDS)
+    seed: int = option(START_SEED, "first episode seed (lerobot-eval's default)")
+    out_dir: Path = option(help="output directory; finished cells are skipped on re-runs", flag="--out")
 
     def __post_init__(self):
+        if bool(self.policy_path) == self.expert:
+            raise InputError("give exactly one of --policy PATH and --expert")
+        object.__setattr__(self, "policy_path", self.policy_path or None)
+        trained = _trained_env(self.policy_path) if self.policy_path else {}
+        for name, default in ENV_DEFAULTS.items():
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, trained.get(name, default))
         object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
         checks.integer("n_episodes", self.n_episodes, 1)
         checks.integer("batch_size", self.batch_size, 1)
@@ -96,6 +139,17 @@ def checkpoint_env(policy_path: str | Path) -> dict:
     if "image_size" in found:
         found["image_size"] = tuple(found["image_size"])
     return found
+
+
+def _trained_env(policy_path: str) -> dict:
+    """`checkpoint_env` of a local checkpoint, nothing for a Hub repo id; a path that is neither is refused."""
+    if Path(policy_path).exists():
+        return checkpoint_env(policy_path)
+    try:
+        checks.repo_id(policy_path)
+    except FieldError:
+        raise FieldError("policy_path", f"{policy_path}: no such checkpoint directory") from None
+    return {}
 
 
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:

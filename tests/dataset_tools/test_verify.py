@@ -15,7 +15,8 @@ from lerobot_tavis.dataset_tools.verify import TOLERANCE_M, verify_dataset
 def dataset_root(tmp_path_factory):
     """Two conditional_pick demonstrations (GR1T2) at 20 Hz, head camera only, 48x64."""
     scratch = tmp_path_factory.mktemp("verify")
-    record(RecordConfig(scratch / "raw", "gr1t2", ("conditional_pick",), 2), progress=False)
+    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",),
+                        episodes_per_task=2), progress=False)
     return convert(ConvertConfig(scratch / "raw", "local/verify", scratch / "dataset", image_size=(48, 64),
                                  cameras=("head",)), progress=False)
 

@@ -14,8 +14,8 @@ from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
 
 
 def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
-    cfg = ProtocolConfig(out_dir=tmp_path, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2,
-                         image_size=(24, 32), workers=1)
+    cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",),
+                         n_episodes=2, image_size=(24, 32), workers=1)
     written = {p.name for p in run_protocol(cfg)}
     assert {"results.md", "results.json", "success_rates.png"} <= written
     cell = tmp_path / "tavis_hands__id"
@@ -39,7 +39,8 @@ def _cell_files(root, cell="tavis_hands__id"):
 
 def test_expert_results_do_not_depend_on_workers_or_chunking(tmp_path):
     """Chunks of one seed finish in any order over 2 workers; the cell is the same as one process playing all."""
-    common = dict(robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2, image_size=(24, 32))
+    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2,
+                  image_size=(24, 32))
     run_protocol(ProtocolConfig(out_dir=tmp_path / "one", workers=1, **common))
     run_protocol(ProtocolConfig(out_dir=tmp_path / "two", workers=2, chunk_episodes=1, **common))
     assert _cell_files(tmp_path / "one") == _cell_files(tmp_path / "two")
@@ -48,8 +49,8 @@ def test_expert_results_do_not_depend_on_workers_or_chunking(tmp_path):
 
 def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     """A chunk whose `done` record exists is not played again: its stored outcome is what the cell reports."""
-    cfg = ProtocolConfig(out_dir=tmp_path, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=1,
-                         image_size=(24, 32), chunk_episodes=1)
+    cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",),
+                         n_episodes=1, image_size=(24, 32), chunk_episodes=1)
     work = tmp_path / ".tavis_hands__id.chunks"
     work.mkdir(parents=True)
     stored = {"robot": "gr1t2", "suite": "tavis_hands", "task": "peeking_box", "task_id": 0, "split": "id",

@@ -11,7 +11,7 @@ from lerobot_tavis.dataset_tools.record import RecordConfig, record
 def raw_dir(tmp_path_factory):
     """Two conditional_pick demonstrations (GR1T2), recorded once; tests damage copies of it."""
     out = tmp_path_factory.mktemp("faults") / "raw"
-    record(RecordConfig(out, "gr1t2", ("conditional_pick",), 2), progress=False)
+    record(RecordConfig(out_dir=out, robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=2), progress=False)
     return out
 
 

@@ -208,18 +208,20 @@ def task_sort_key(name: str) -> tuple[int, str]:
     return (order.index(name) if name in order else len(order), name)
 
 
-def task_info(name: str) -> TaskInfo:
+def task_info(name: str, field: str = "task") -> TaskInfo:
+    """The declaration of task `name`; an unknown name is a FieldError of `field`."""
     try:
         return TASKS[name]
     except KeyError:
-        raise FieldError("task", f"must be one of {sorted(TASKS)}, got {name!r}") from None
+        raise FieldError(field, f"must be one of {sorted(TASKS)}, got {name!r}") from None
 
 
-def expand_tasks(spec: str) -> dict[str, list[str]]:
-    """`tavis_head`, `peeking_box` or `tavis_head,occluded_reach` -> {suite: [task, ...]}, in the given order."""
+def expand_tasks(spec: str, field: str = "task") -> dict[str, list[str]]:
+    """`tavis_head`, `peeking_box` or `tavis_head,occluded_reach` -> {suite: [task, ...]}, in the given order; an
+    unknown name is a FieldError of `field`."""
     groups: dict[str, list[str]] = {}
     for item in (part.strip() for part in spec.split(",")):
-        names = suite_tasks(item) if item in suite_names() else (task_info(item).name,)
+        names = suite_tasks(item) if item in suite_names() else (task_info(item, field).name,)
         for name in names:
             suite = task_info(name).suite
             if name not in groups.setdefault(suite, []):
