@@ -64,6 +64,9 @@ class TavisEnvConfig(EnvConfig):
     features: dict[str, PolicyFeature] = field(default_factory=dict)
     # Derived from camera_mode; not to be set
     features_map: dict[str, str] = field(default_factory=dict)
+    # Sub-envs of an async batch that draw video frames (lerobot-eval films at most 10 episodes of a batch, from its
+    # first sub-envs); the others skip the overview render that filming costs
+    filmed_envs: int = 10
     # Tasks of a suite that lerobot-eval runs at once (threads)
     max_parallel_tasks: int = 1
     # Skip gymnasium's env checker
@@ -78,6 +81,7 @@ class TavisEnvConfig(EnvConfig):
             raise FieldError("fps", f"is fixed by the benchmark at 20, got {self.fps}")
         height, width = checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, self.fps)
+        checks.integer("filmed_envs", self.filmed_envs, 0)
         self.features = {"action": PolicyFeature(FeatureType.ACTION, (canonical.ACTION_DIM,)),
                          "agent_pos": PolicyFeature(FeatureType.STATE, (canonical.ACTION_DIM,))}
         self.features_map = {"action": "action", "agent_pos": "observation.state"}
@@ -101,7 +105,8 @@ class TavisEnvConfig(EnvConfig):
                 if use_async_envs and n_envs > 1:
                     probe = factory.func(task, **self.gym_kwargs)  # spaces only: builds no simulator
                     envs[suite][task_id] = LazyAsyncVectorEnv([factory] * n_envs, probe.observation_space,
-                                                              probe.action_space, probe.metadata)
+                                                              probe.action_space, probe.metadata,
+                                                              filmed_envs=self.filmed_envs)
                 else:
                     envs[suite][task_id] = gym.vector.SyncVectorEnv(
                         [Frozen(factory)] * n_envs,

@@ -9,7 +9,10 @@ envs. This module gives the same two behaviours from classes that import only gy
   terminal transition (reward 0) instead of simulating, until an explicit reset carrying LeRobot's new-rollout
   option (`NEW_ROLLOUT_OPTION`, the key lerobot-eval's rollout passes) starts the next episode.
 - `LazyAsyncVectorEnv`: the AsyncVectorEnv (forkserver workers, shared memory, next-step autoreset) is created on
-  first use, so one task's workers are alive at a time while lerobot-eval walks a suite.
+  first use, so one task's workers are alive at a time while lerobot-eval walks a suite. Only its first
+  `filmed_envs` sub-envs draw video frames: lerobot-eval films at most 10 episodes of a batch, from its first
+  sub-envs, yet asks every sub-env of an async batch for a frame at each step (about 1 MB each, the overview
+  rendered, composed and sent through a pipe); the others answer `render()` with None.
 """
 
 from __future__ import annotations
@@ -45,23 +48,34 @@ class FreezeAfterEpisodeEnd(gym.Wrapper):
         return observation, reward, terminated, truncated, info
 
 
+class Unfilmed(gym.Wrapper):
+    """A sub-env whose frames nobody films: `render()` returns None and costs nothing."""
+
+    def render(self):
+        return None
+
+
 @dataclass(frozen=True)
 class Frozen:
-    """A sub-env factory whose env freezes after its episode (picklable by reference to this module)."""
+    """A sub-env factory whose env freezes after its episode (picklable by reference to this module); an env not
+    `filmed` renders no frame."""
 
     make: Callable[[], gym.Env]
+    filmed: bool = True
 
     def __call__(self) -> gym.Env:
-        return FreezeAfterEpisodeEnd(self.make())
+        env = FreezeAfterEpisodeEnd(self.make())
+        return env if self.filmed else Unfilmed(env)
 
 
 class LazyAsyncVectorEnv:
     """An AsyncVectorEnv of `Frozen(factory)` sub-envs, started on the first reset, step, call or attribute read.
-    `observation_space`, `action_space` and `metadata` are those of one sub-env, given up front."""
+    `observation_space`, `action_space` and `metadata` are those of one sub-env, given up front; sub-envs from
+    index `filmed_envs` on render no frame."""
 
     def __init__(self, factories: list[Callable[[], gym.Env]], observation_space: gym.Space,
-                 action_space: gym.Space, metadata: dict):
-        self._factories = [Frozen(factory) for factory in factories]
+                 action_space: gym.Space, metadata: dict, filmed_envs: int = 10):
+        self._factories = [Frozen(factory, filmed=index < filmed_envs) for index, factory in enumerate(factories)]
         self._env: gym.vector.AsyncVectorEnv | None = None
         self.num_envs = len(factories)
         self.observation_space = self.single_observation_space = observation_space

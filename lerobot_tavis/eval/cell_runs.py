@@ -10,8 +10,9 @@ hidden folder `.<cell>.chunks/` (episode log and a `done` record), so a killed r
 
 - Demonstrators render nothing: they act on the simulator state, so pixels cannot change an outcome (the camera
   mode still fixes whether the neck moves).
-- Policies run through LeRobot's own `eval_main`, each chunk in a scratch folder; the first chunk of each task
-  keeps lerobot-eval's videos (up to 10 episodes), as one lerobot-eval run of the cell would.
+- Policies run as lerobot-eval runs (`lerobot_run.evaluate`: LeRobot's env, policy, processors and
+  `eval_policy_all`), each chunk in a scratch folder; the first chunk of each task films its first
+  `film_episodes` episodes, the other chunks film none (lerobot-eval films 10 and holds their frames in memory).
 """
 
 from __future__ import annotations
@@ -162,9 +163,9 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
     worker)."""
     from lerobot.configs.default import EvalConfig
     from lerobot.configs.eval import EvalPipelineConfig
-    from lerobot.scripts.lerobot_eval import eval_main
 
     from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.lerobot_run import evaluate
 
     if cfg.device != "cpu":
         _share_cores(cfg.workers)
@@ -172,17 +173,18 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
     batch = min(cfg.batch_size, chunk.n)
     with tempfile.TemporaryDirectory(prefix="tavis-chunk-") as scratch:
         out = Path(scratch) / "eval"
+        film = cfg.film_episodes if chunk.first_seed == cfg.seed else 0  # the task's first episodes only
         env = TavisEnvConfig(task=chunk.task, robot=cfg.robot, camera_mode=cfg.camera_mode, split=chunk.split,
                              image_size=cfg.image_size, episode_length_s=cfg.episode_length_s,
-                             episode_log=str(out / EPISODE_LOG_NAME))
-        eval_main(EvalPipelineConfig(env=env, eval=EvalConfig(n_episodes=chunk.n, batch_size=batch,
-                                                              use_async_envs=batch > 1),
-                                     policy=policy, output_dir=out, seed=chunk.first_seed))
+                             episode_log=str(out / EPISODE_LOG_NAME), filmed_envs=film)
+        evaluate(EvalPipelineConfig(env=env, eval=EvalConfig(n_episodes=chunk.n, batch_size=batch,
+                                                             use_async_envs=batch > 1),
+                                    policy=policy, output_dir=out, seed=chunk.first_seed), film_episodes=film)
         task_metrics = json.loads((out / EVAL_INFO_NAME).read_text())["per_task"][0]["metrics"]
-        lines = [json.loads(line) | {"task_id": chunk.task_id}  # the run saw a one-task suite
-                 for line in (out / EPISODE_LOG_NAME).read_text().splitlines()]
-        videos = ({path.name: path.read_bytes() for path in sorted((out / "videos").rglob("*.mp4"))}
-                  if chunk.first_seed == cfg.seed else {})
+        lines = sorted((json.loads(line) | {"task_id": chunk.task_id}  # the run saw a one-task suite
+                        for line in (out / EPISODE_LOG_NAME).read_text().splitlines()),
+                       key=lambda record: record["seed"])  # async envs log in the order episodes finish
+        videos = {path.name: path.read_bytes() for path in sorted((out / "videos").rglob("*.mp4"))}
         return ChunkResult(chunk, "".join(json.dumps(line) + "\n" for line in lines),
                            {key: task_metrics[key] for key in METRICS}, videos)
 

@@ -2,10 +2,10 @@
 
 Cells are suite x split (`id`, `ood_spatial`, `ood_init_pose`), 96 episodes per task by default, seeds from 1000
 as lerobot-eval uses them. Policy and demonstrators alike play (cell, task, seed chunk) jobs over all workers
-(`cell_runs`): a policy chunk is one run of LeRobot's own `eval_main`, so several share one GPU; the demonstrators
-play through the same env and episode log. Finished chunks survive a kill and each cell is moved into place when
-complete, so a re-run skips finished cells and chunks. `wall_clock_s.txt` in a cell is the time from the start of
-the command to the cell's completion. The report (`tavis report`) is written at the end.
+(`cell_runs`): a policy chunk is one lerobot-eval run in a worker process, so several share one GPU; the
+demonstrators play through the same env and episode log. Finished chunks survive a kill and each cell is moved
+into place when complete, so a re-run skips finished cells and chunks. `wall_clock_s.txt` in a cell is the time
+from the start of the command to the cell's completion. The report (`tavis report`) is written at the end.
 """
 
 from __future__ import annotations
@@ -85,6 +85,8 @@ class ProtocolConfig:
     chunk_episodes: int | None = option(None, "consecutive episodes per job, also what a killed run loses at most "
                                         "(default 8 for the demonstrators, 96 for a policy: each policy job starts "
                                         "a lerobot-eval run)")
+    film_episodes: int = option(4, "episodes filmed per task and split, its first ones (default 4; lerobot-eval "
+                                "films 10): a filming job holds about 1 GB of frames per filmed episode at 20 s")
     backend: str = option("local", "local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)",
                           choices=BACKENDS)
     seed: int = option(START_SEED, "first episode seed (lerobot-eval's default)")
@@ -103,6 +105,7 @@ class ProtocolConfig:
         checks.integer("batch_size", self.batch_size, 1)
         checks.integer("workers", self.workers, 1)
         checks.integer("seed", self.seed, 0)
+        checks.integer("film_episodes", self.film_episodes, 0)
         if self.chunk_episodes is not None:
             checks.integer("chunk_episodes", self.chunk_episodes, 1)
         checks.choice("backend", self.backend, BACKENDS)

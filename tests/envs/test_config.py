@@ -86,6 +86,22 @@ def test_async_create_envs_run_in_forkserver_workers():
     assert len(mapped) == 2 and not any("libtorch" in maps or "/lerobot/" in maps for maps in mapped)
 
 
+def test_only_the_filmed_sub_envs_of_an_async_batch_draw_frames():
+    """lerobot-eval asks every async sub-env for a frame each step but films only its first ones."""
+    config = TavisEnvConfig(task="wait_then_act", image_size=(24, 32), filmed_envs=1)
+    vec = config.create_envs(n_envs=3, use_async_envs=True)["tavis_head"][0]
+    vec.reset(seed=[1000, 1001, 1002], options={NEW_ROLLOUT_OPTION: True})
+    frames = vec.call("render")
+    vec.close()
+    assert frames[0].ndim == 3 and frames[0].dtype == np.uint8 and frames[0].shape[0] > 24  # overview + views
+    assert frames[1:] == (None, None)
+
+
+def test_a_negative_filmed_env_count_is_refused():
+    with pytest.raises(ValueError, match="filmed_envs must be an integer >= 0"):
+        TavisEnvConfig(filmed_envs=-1)
+
+
 def test_the_new_rollout_option_is_lerobots():
     assert NEW_ROLLOUT_OPTION == lerobot_env_utils.NEW_ROLLOUT_OPTION
 

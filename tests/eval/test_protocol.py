@@ -10,6 +10,7 @@ import pytest
 from lerobot_tavis.cli import main
 from lerobot_tavis.eval import protocol
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
+from lerobot_tavis.errors import FieldError
 from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
 
 
@@ -167,6 +168,26 @@ def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first
     videos = one[1]["per_task"][0]["metrics"]["video_paths"]
     assert videos == ["videos/tavis_head_0/eval_episode_0.mp4"]  # from the chunk of seed 1000 only
     assert (tmp_path / "one" / "tavis_head__id" / videos[0]).stat().st_size > 0
+
+
+def test_filming_changes_no_result_and_zero_films_nothing(tmp_path):
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    common = dict(suites=("tavis_hands",), splits=("id",), n_episodes=2, image_size=(32, 48), episode_length_s=0.5,
+                  policy_path=str(tmp_path / "ckpt"), policy_options=(("num_inference_steps", 1),), batch_size=2)
+    run_protocol(ProtocolConfig(out_dir=tmp_path / "films", film_episodes=2, **common))
+    run_protocol(ProtocolConfig(out_dir=tmp_path / "none", film_episodes=0, **common))
+    films, none = _cell_files(tmp_path / "films", "tavis_hands__id"), _cell_files(tmp_path / "none", "tavis_hands__id")
+    assert films[0] == none[0]  # the episode logs
+    assert [t["metrics"]["successes"] for t in films[1]["per_task"]] == [
+        t["metrics"]["successes"] for t in none[1]["per_task"]]
+    assert [len(t["metrics"]["video_paths"]) for t in films[1]["per_task"]] == [2, 2, 2]
+    assert [t["metrics"]["video_paths"] for t in none[1]["per_task"]] == [[], [], []]
+    assert not (tmp_path / "none" / "tavis_hands__id" / "videos").exists()
+
+
+def test_a_negative_film_count_is_refused(tmp_path):
+    with pytest.raises(FieldError, match="film_episodes"):
+        ProtocolConfig(out_dir=tmp_path, expert=True, film_episodes=-1)
 
 
 def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path):

@@ -1,0 +1,54 @@
+"""One lerobot-eval run inside this process, filming as many episodes as asked.
+
+LeRobot's `eval_main` films the first 10 episodes of every task, and while it films a batch it holds every frame of
+the batch's filmed episodes in memory, then a second, stacked copy while the videos are written: about
+2 x 400 steps x 10 episodes x 1.3 MB = 10 GB per run at 240x320, which is what ended the protocol runs that shared
+one GPU machine (docs/benchmarks.md). `evaluate` builds the run exactly as `eval_main` does (LeRobot's env, policy
+and processors from the same `EvalPipelineConfig`), then calls LeRobot's `eval_policy_all` with `film_episodes`;
+it writes the same `eval_info.json`. With `film_episodes=0` no frame is rendered for a video at all.
+"""
+
+from __future__ import annotations
+
+import json
+from contextlib import nullcontext
+from pathlib import Path
+
+from lerobot_tavis.atomic import write_text
+from lerobot_tavis.eval.report import EVAL_INFO_NAME
+
+
+def evaluate(cfg, film_episodes: int) -> None:
+    """Run the evaluation `cfg` (a LeRobot `EvalPipelineConfig`), filming the first `film_episodes` episodes of each
+    task into `<output_dir>/videos/`; write `<output_dir>/eval_info.json`."""
+    import torch
+    from lerobot.envs import close_envs, make_env, make_env_pre_post_processors
+    from lerobot.policies import make_policy, make_pre_post_processors
+    from lerobot.scripts.lerobot_eval import eval_policy_all
+    from lerobot.utils.device_utils import get_safe_torch_device
+    from lerobot.utils.random_utils import set_seed
+
+    device = get_safe_torch_device(cfg.policy.device)
+    torch.backends.cudnn.benchmark = True  # as eval_main sets them, so that results equal a lerobot-eval run's
+    torch.backends.cuda.matmul.allow_tf32 = True
+    set_seed(cfg.seed)
+    envs = make_env(cfg.env, n_envs=cfg.eval.batch_size, use_async_envs=cfg.eval.use_async_envs,
+                    trust_remote_code=cfg.trust_remote_code)
+    try:
+        policy = make_policy(cfg=cfg.policy, env_cfg=cfg.env, rename_map=cfg.rename_map)
+        policy.eval()
+        preprocessor, postprocessor = make_pre_post_processors(
+            policy_cfg=cfg.policy, pretrained_path=cfg.policy.pretrained_path,
+            preprocessor_overrides={"device_processor": {"device": str(policy.config.device)},
+                                    "rename_observations_processor": {"rename_map": cfg.rename_map}})
+        env_preprocessor, env_postprocessor = make_env_pre_post_processors(env_cfg=cfg.env, policy_cfg=cfg.policy)
+        autocast = torch.autocast(device_type=device.type) if cfg.policy.use_amp else nullcontext()
+        with torch.no_grad(), autocast:
+            info = eval_policy_all(envs=envs, policy=policy, env_preprocessor=env_preprocessor,
+                                   env_postprocessor=env_postprocessor, preprocessor=preprocessor,
+                                   postprocessor=postprocessor, n_episodes=cfg.eval.n_episodes,
+                                   max_episodes_rendered=film_episodes, videos_dir=Path(cfg.output_dir) / "videos",
+                                   start_seed=cfg.seed, max_parallel_tasks=cfg.env.max_parallel_tasks)
+    finally:
+        close_envs(envs)
+    write_text(Path(cfg.output_dir) / EVAL_INFO_NAME, json.dumps(info, indent=2))
