@@ -154,15 +154,20 @@ def test_policy_protocol_runs_through_lerobot_eval(tmp_path):
         (task, "ood_init_pose", 1) for task in suite_tasks("tavis_head")]
 
 
+def _tiny_policy_cell(tmp_path, name: str, suite: str, **settings):
+    """The id cell of `suite` (2 episodes per task) played by a tiny diffusion checkpoint made once per test."""
+    if not (tmp_path / "ckpt").exists():
+        _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    run_protocol(ProtocolConfig(out_dir=tmp_path / name, suites=(suite,), splits=("id",), n_episodes=2,
+                                image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
+                                policy_options=(("num_inference_steps", 1),), **settings))
+    return _cell_files(tmp_path / name, f"{suite}__id")
+
+
 def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first_videos(tmp_path):
     """Each chunk is one lerobot-eval run seeded with its first seed: two workers give the cell of one."""
-    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
-    common = dict(suites=("tavis_head",), splits=("id",), n_episodes=2, image_size=(32, 48), episode_length_s=0.5,
-                  policy_path=str(tmp_path / "ckpt"), policy_options=(("num_inference_steps", 1),), chunk_episodes=1)
-    run_protocol(ProtocolConfig(out_dir=tmp_path / "one", workers=1, **common))
-    run_protocol(ProtocolConfig(out_dir=tmp_path / "two", workers=2, **common))
-    one, two = _cell_files(tmp_path / "one", "tavis_head__id"), _cell_files(tmp_path / "two", "tavis_head__id")
-    assert one == two
+    one = _tiny_policy_cell(tmp_path, "one", "tavis_head", workers=1, chunk_episodes=1)
+    assert one == _tiny_policy_cell(tmp_path, "two", "tavis_head", workers=2, chunk_episodes=1)
     records = [json.loads(line) for line in one[0].splitlines()]
     assert [(r["task_id"], r["seed"]) for r in records] == [(t, s) for t in range(5) for s in (1000, 1001)]
     videos = one[1]["per_task"][0]["metrics"]["video_paths"]
@@ -171,12 +176,8 @@ def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first
 
 
 def test_filming_changes_no_result_and_zero_films_nothing(tmp_path):
-    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
-    common = dict(suites=("tavis_hands",), splits=("id",), n_episodes=2, image_size=(32, 48), episode_length_s=0.5,
-                  policy_path=str(tmp_path / "ckpt"), policy_options=(("num_inference_steps", 1),), batch_size=2)
-    run_protocol(ProtocolConfig(out_dir=tmp_path / "films", film_episodes=2, **common))
-    run_protocol(ProtocolConfig(out_dir=tmp_path / "none", film_episodes=0, **common))
-    films, none = _cell_files(tmp_path / "films", "tavis_hands__id"), _cell_files(tmp_path / "none", "tavis_hands__id")
+    films = _tiny_policy_cell(tmp_path, "films", "tavis_hands", batch_size=2, film_episodes=2)
+    none = _tiny_policy_cell(tmp_path, "none", "tavis_hands", batch_size=2, film_episodes=0)
     assert films[0] == none[0]  # the episode logs
     assert [t["metrics"]["successes"] for t in films[1]["per_task"]] == [
         t["metrics"]["successes"] for t in none[1]["per_task"]]
