@@ -2,7 +2,7 @@
 # One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact ACT policy -> evaluation
 # of every checkpoint (96 episodes each, Wilson intervals and GALT by `tavis report`).
 #
-#   benchmarks/train_baseline.sh cell|data|train|eval|overfit
+#   benchmarks/train_baseline.sh pair|cell|data|train|eval|overfit
 #
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
@@ -10,6 +10,9 @@
 # 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), WORK
 # (/tmp/tavis_baseline).
 #
+# - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
+#   GPU where the machine has two or more (a two-GPU slot gives both arms of the comparison); logs in
+#   $WORK/cell_<condition>.log.
 # - cell: the whole cell within one 30-minute GPU slot: data, then training stopped after TRAIN_S seconds (780)
 #   with BATCH 128 and SAVE_FREQ 1500 unless set (loaders: WORKERS - 2), the checkpoints evaluated at low CPU
 #   priority as they appear, and those left after training ends side by side.
@@ -45,6 +48,11 @@ choose_video_backend() {  # BACKEND=torchcodec when it loads (with PyAV's FFmpeg
   BACKEND=$(python3 -c "from lerobot_tavis.dataset_tools.quiet import video_backend; print(video_backend())")
 }
 
+record() {  # the demonstrations, once: every condition of TASK converts the same ones
+  [ -f "$WORK/raw/manifest.json" ] || time tavis record --robot "$ROBOT" --tasks "$TASK" \
+    --episodes-per-task "$EPISODES" --workers "$WORKERS" --out "$WORK/raw"
+}
+
 convert() {  # convert RAW_DIR DATASET_DIR
   tavis convert "$1" --repo-id "local/$(basename "$2")" --root "$2" --fps 20 --image-size "$SIZE" \
     --cameras "$CAMERAS" "${NECK[@]}" --workers "$WORKERS" --overwrite
@@ -68,6 +76,18 @@ evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES
 }
 
 case "${1:-}" in
+  pair)
+    record
+    gpus=$(nvidia-smi -L 2>/dev/null | grep -c '^GPU' || true)
+    index=0
+    for condition in head_wrist fixed_wrist; do
+      ( if (( gpus > 1 )); then export CUDA_VISIBLE_DEVICES=$(( index % gpus )); fi
+        CONDITION=$condition WORKERS=$(( WORKERS > 1 ? WORKERS / 2 : 1 )) "$0" cell > "$WORK/cell_$condition.log" 2>&1
+      ) &
+      index=$(( index + 1 ))
+    done
+    wait
+    ;;
   cell)
     "$0" data
     stopped="$WORK/train_$CONDITION.stopped"
@@ -84,8 +104,7 @@ case "${1:-}" in
     wait
     ;;
   data)
-    [ -f "$WORK/raw/manifest.json" ] || time tavis record --robot "$ROBOT" --tasks "$TASK" \
-      --episodes-per-task "$EPISODES" --workers "$WORKERS" --out "$WORK/raw"
+    record
     time convert "$WORK/raw" "$WORK/dataset_$CONDITION"
     ;;
   train)
@@ -124,7 +143,7 @@ PY
     evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/new_seeds" 1000 8
     ;;
   *)
-    echo "usage: $0 cell|data|train|eval|overfit" >&2
+    echo "usage: $0 pair|cell|data|train|eval|overfit" >&2
     exit 2
     ;;
 esac
