@@ -179,7 +179,7 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
                              episode_log=str(out / EPISODE_LOG_NAME), filmed_envs=film)
         evaluate(EvalPipelineConfig(env=env, eval=EvalConfig(n_episodes=chunk.n, batch_size=batch,
                                                              use_async_envs=batch > 1),
-                                    policy=policy, output_dir=out, seed=chunk.first_seed), film_episodes=film)
+                                    policy=policy, output_dir=out, seed=chunk.first_seed))
         task_metrics = json.loads((out / EVAL_INFO_NAME).read_text())["per_task"][0]["metrics"]
         lines = sorted((json.loads(line) | {"task_id": chunk.task_id}  # the run saw a one-task suite
                         for line in (out / EPISODE_LOG_NAME).read_text().splitlines()),

@@ -1,11 +1,12 @@
-"""One lerobot-eval run inside this process, filming as many episodes as asked.
+"""One lerobot-eval run inside this process, filming as many episodes as its env config's `filmed_envs`.
 
 LeRobot's `eval_main` films the first 10 episodes of every task, and while it films a batch it holds every frame of
 the batch's filmed episodes in memory, then a second, stacked copy while the videos are written: about
 2 x 400 steps x 10 episodes x 1.3 MB = 10 GB per run at 240x320, which is what ended the protocol runs that shared
 one GPU machine (docs/benchmarks.md). `evaluate` builds the run exactly as `eval_main` does (LeRobot's env, policy
-and processors from the same `EvalPipelineConfig`), then calls LeRobot's `eval_policy_all` with `film_episodes`;
-it writes the same `eval_info.json`. With `film_episodes=0` no frame is rendered for a video at all.
+and processors from the same `EvalPipelineConfig`), then calls LeRobot's `eval_policy_all` filming the episodes of
+the sub-envs that draw frames (`TavisEnvConfig.filmed_envs`); it writes the same `eval_info.json`. With
+`filmed_envs=0` no frame is rendered for a video at all.
 """
 
 from __future__ import annotations
@@ -18,9 +19,9 @@ from lerobot_tavis.atomic import write_text
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
 
 
-def evaluate(cfg, film_episodes: int) -> None:
-    """Run the evaluation `cfg` (a LeRobot `EvalPipelineConfig`), filming the first `film_episodes` episodes of each
-    task into `<output_dir>/videos/`; write `<output_dir>/eval_info.json`."""
+def evaluate(cfg) -> None:
+    """Run the evaluation `cfg` (a LeRobot `EvalPipelineConfig` of the tavis env), filming the first
+    `cfg.env.filmed_envs` episodes of each task into `<output_dir>/videos/`; write `<output_dir>/eval_info.json`."""
     import torch
     from lerobot.envs import close_envs, make_env, make_env_pre_post_processors
     from lerobot.policies import make_policy, make_pre_post_processors
@@ -47,7 +48,8 @@ def evaluate(cfg, film_episodes: int) -> None:
             info = eval_policy_all(envs=envs, policy=policy, env_preprocessor=env_preprocessor,
                                    env_postprocessor=env_postprocessor, preprocessor=preprocessor,
                                    postprocessor=postprocessor, n_episodes=cfg.eval.n_episodes,
-                                   max_episodes_rendered=film_episodes, videos_dir=Path(cfg.output_dir) / "videos",
+                                   max_episodes_rendered=cfg.env.filmed_envs,
+                                   videos_dir=Path(cfg.output_dir) / "videos",
                                    start_seed=cfg.seed, max_parallel_tasks=cfg.env.max_parallel_tasks)
     finally:
         close_envs(envs)
