@@ -11,8 +11,8 @@
 # (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
-#   GPU where the machine has two or more (a two-GPU slot gives both arms of the comparison); logs in
-#   $WORK/cell_<condition>.log.
+#   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
+#   comparison); logs in $WORK/cell_<condition>.log.
 # - cell: the whole cell within one 30-minute GPU slot: data, then training stopped after TRAIN_S seconds (780)
 #   with BATCH 128 and SAVE_FREQ 1500 unless set (loaders: WORKERS - 2), the checkpoints evaluated at low CPU
 #   priority as they appear, and those left after training ends side by side.
@@ -78,10 +78,11 @@ evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES
 case "${1:-}" in
   pair)
     record
-    gpus=$(nvidia-smi -L 2>/dev/null | grep -c '^GPU' || true)
+    if [ -n "${CUDA_VISIBLE_DEVICES:-}" ]; then gpus=(${CUDA_VISIBLE_DEVICES//,/ })
+    else mapfile -t gpus < <(nvidia-smi --query-gpu=index --format=csv,noheader 2>/dev/null || true); fi
     index=0
     for condition in head_wrist fixed_wrist; do
-      ( if (( gpus > 1 )); then export CUDA_VISIBLE_DEVICES=$(( index % gpus )); fi
+      ( if (( ${#gpus[@]} > 1 )); then export CUDA_VISIBLE_DEVICES=${gpus[index % ${#gpus[@]}]}; fi
         CONDITION=$condition WORKERS=$(( WORKERS > 1 ? WORKERS / 2 : 1 )) "$0" cell > "$WORK/cell_$condition.log" 2>&1
       ) &
       index=$(( index + 1 ))
