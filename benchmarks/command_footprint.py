@@ -6,7 +6,9 @@ Samples the memory of the command's process tree (read from /proc) every `--inte
 of two sums: resident memory (RSS, which counts a shared library once per process that maps it) and proportional
 memory (PSS, which splits shared pages among the processes sharing them: what the tree really holds), and the
 largest process count; CPU time is the tree's user + system time (every descendant
-that was waited for is counted by the operating system in its parent's children times). Linux only.
+that was waited for is counted by the operating system in its parent's children times). `cores` is the number of
+CPUs the command may run on (its CPU affinity, e.g. under `taskset`), and `machine_busy_percent` its CPU use over
+those. Linux only.
 """
 
 from __future__ import annotations
@@ -66,9 +68,10 @@ def main() -> None:
     wall_s = time.perf_counter() - start
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu_s = usage.ru_utime + usage.ru_stime
+    cores = len(os.sched_getaffinity(0))
     result = {"command": " ".join(command), "returncode": process.returncode, "wall_s": round(wall_s, 1),
-              "cpu_s": round(cpu_s, 1), "cpu_percent": round(100 * cpu_s / wall_s), "cores": os.cpu_count(),
-              "machine_busy_percent": round(100 * cpu_s / wall_s / os.cpu_count(), 1),
+              "cpu_s": round(cpu_s, 1), "cpu_percent": round(100 * cpu_s / wall_s), "cores": cores,
+              "machine_busy_percent": round(100 * cpu_s / wall_s / cores, 1),
               "peak_rss_gib": round(peak_rss_kib / 2**20, 2), "peak_pss_gib": round(peak_pss_kib / 2**20, 2),
               "peak_processes": peak_processes}
     print(json.dumps(result))

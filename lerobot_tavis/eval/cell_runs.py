@@ -190,14 +190,14 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
 
 
 def _share_cores(jobs: int) -> None:
-    """Give this job's torch its share of the machine's cores. Each process's torch uses every core by default, so
-    `jobs` policy jobs at once oversubscribed them (16-core GPU machine, 5 jobs: 80 torch threads, each job's main
-    process at 200-500% CPU while its env workers waited). Only for a policy on an accelerator: there the CPU work
-    is element-wise; a policy on the CPU keeps torch's default, as its results would depend on the thread count,
-    and so on `--workers`."""
+    """Give this job's torch its share of the cores this process may run on (its CPU affinity: `taskset`, a
+    container's cpuset). Each process's torch uses every core by default, so `jobs` policy jobs at once
+    oversubscribed them (16-core GPU machine, 5 jobs: 80 torch threads, each job's main process at 200-500% CPU
+    while its env workers waited). Only for a policy on an accelerator: there the CPU work is element-wise; a policy
+    on the CPU keeps torch's default, as its results would depend on the thread count, and so on `--workers`."""
     import torch
 
-    torch.set_num_threads(max(1, (os.cpu_count() or 1) // jobs))
+    torch.set_num_threads(max(1, len(os.sched_getaffinity(0)) // jobs))
 
 
 def _close_envs() -> None:
