@@ -7,8 +7,8 @@
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
 # demonstrations, as many as the reference's datasets hold per task), STEPS, SAVE_FREQ and BATCH (the preset's, 6000,
-# 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), WORK
-# (/tmp/tavis_baseline).
+# 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), FILM
+# (episodes filmed per evaluation: 2, as each filmed sub-env also renders the overview), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
@@ -33,6 +33,7 @@ ROBOT=${ROBOT:-gr1t2}
 EPISODES=${EPISODES:-160}
 WORKERS=${WORKERS:-$(nproc)}
 EVAL_EPISODES=${EVAL_EPISODES:-96}
+FILM=${FILM:-2}
 WORK=${WORK:-/tmp/tavis_baseline}
 export MUJOCO_GL=${MUJOCO_GL:-egl}
 case "$CONDITION" in
@@ -71,7 +72,7 @@ evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES
   lerobot-eval --policy.path="$1/pretrained_model" --policy.device=cuda --policy.use_amp=true --env.type=tavis \
     --env.task="$TASK" --env.robot="$ROBOT" --env.camera_mode="$CONDITION" --env.image_size="[${SIZE/x/,}]" \
     --seed="$3" --eval.n_episodes="$4" --eval.batch_size=$(( $4 < 48 ? $4 : 48 )) --eval.use_async_envs=true \
-    --output_dir="$2"
+    --env.filmed_envs="$FILM" --output_dir="$2"
   tavis report "$2"
 }
 

@@ -162,10 +162,9 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
     """Play one chunk with the policy: one lerobot-eval run of its task and seeds, in a scratch folder (in a
     worker)."""
     from lerobot.configs.default import EvalConfig
-    from lerobot.configs.eval import EvalPipelineConfig
 
     from lerobot_tavis.envs.config import TavisEnvConfig
-    from lerobot_tavis.eval.lerobot_run import evaluate
+    from lerobot_tavis.eval.lerobot_run import evaluate, pipeline_config
 
     if cfg.device != "cpu":
         _share_cores(cfg.workers)
@@ -177,9 +176,9 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
         env = TavisEnvConfig(task=chunk.task, robot=cfg.robot, camera_mode=cfg.camera_mode, split=chunk.split,
                              image_size=cfg.image_size, episode_length_s=cfg.episode_length_s,
                              episode_log=str(out / EPISODE_LOG_NAME), filmed_envs=film)
-        evaluate(EvalPipelineConfig(env=env, eval=EvalConfig(n_episodes=chunk.n, batch_size=batch,
-                                                             use_async_envs=batch > 1),
-                                    policy=policy, output_dir=out, seed=chunk.first_seed))
+        batches = EvalConfig(n_episodes=chunk.n, batch_size=batch, use_async_envs=batch > 1)
+        evaluate(pipeline_config(env=env, eval=batches, policy=policy, output_dir=out, seed=chunk.first_seed,
+                                 job_name=f"tavis_{chunk.task}_{chunk.split}"))
         task_metrics = json.loads((out / EVAL_INFO_NAME).read_text())["per_task"][0]["metrics"]
         lines = sorted((json.loads(line) | {"task_id": chunk.task_id}  # the run saw a one-task suite
                         for line in (out / EPISODE_LOG_NAME).read_text().splitlines()),

@@ -12,11 +12,40 @@ the sub-envs that draw frames (`TavisEnvConfig.filmed_envs`); it writes the same
 from __future__ import annotations
 
 import json
+import logging
 from contextlib import nullcontext
 from pathlib import Path
 
 from lerobot_tavis.atomic import write_text
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
+
+
+def pipeline_config(**fields):
+    """LeRobot's `EvalPipelineConfig(**fields)` for a policy config whose `pretrained_path` is set. Its constructor
+    looks for `--policy.path` on the command line and, not finding it there, warns that the policy will be built
+    with random weights, which is not so here: that one warning is dropped."""
+    from lerobot.configs.eval import EvalPipelineConfig
+
+    if fields["policy"].pretrained_path is None:
+        raise ValueError("pipeline_config: the policy config has no pretrained_path")
+    logger = logging.getLogger("lerobot.configs.eval")
+    drop = _DropMessage("No pretrained path was provided")
+    logger.addFilter(drop)
+    try:
+        return EvalPipelineConfig(**fields)
+    finally:
+        logger.removeFilter(drop)
+
+
+class _DropMessage(logging.Filter):
+    """Drops the log records whose message starts with `prefix`."""
+
+    def __init__(self, prefix: str):
+        super().__init__()
+        self.prefix = prefix
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not record.getMessage().startswith(self.prefix)
 
 
 def evaluate(cfg) -> None:

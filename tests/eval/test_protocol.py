@@ -1,6 +1,7 @@
 """The protocol runner (demonstrators and a policy checkpoint through LeRobot's eval) and lerobot-eval itself."""
 
 import json
+import logging
 import os
 import subprocess
 import sys
@@ -203,3 +204,22 @@ def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path):
     records = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
     assert sorted(r["seed"] for r in records) == [1000, 1001]
     assert all("galt_s" in r and r["length_steps"] == 10 for r in records)
+
+
+def test_the_eval_config_of_a_checkpoint_does_not_warn_of_random_weights(caplog):
+    from lerobot.configs.eval import EvalPipelineConfig
+    from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
+
+    from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.lerobot_run import pipeline_config
+
+    policy = DiffusionConfig(pretrained_path="ckpt")
+    with caplog.at_level(logging.WARNING, logger="lerobot.configs.eval"):
+        EvalPipelineConfig(env=TavisEnvConfig(), policy=policy, job_name="probe")
+        assert "random weights" in caplog.text  # LeRobot's own config warns: the check below can fail
+        caplog.clear()
+        cfg = pipeline_config(env=TavisEnvConfig(), policy=policy, job_name="probe")
+    assert "random weights" not in caplog.text
+    assert cfg.policy.pretrained_path == "ckpt"
+    with pytest.raises(ValueError, match="pretrained_path"):
+        pipeline_config(env=TavisEnvConfig(), policy=DiffusionConfig(), job_name="probe")
