@@ -12,7 +12,8 @@ envs. This module gives the same two behaviours from classes that import only gy
   first use, so one task's workers are alive at a time while lerobot-eval walks a suite. Only its first
   `filmed_envs` sub-envs draw video frames: lerobot-eval films at most 10 episodes of a batch, from its first
   sub-envs, yet asks every sub-env of an async batch for a frame at each step (about 1 MB each, the overview
-  rendered, composed and sent through a pipe); the others answer `render()` with None.
+  rendered, composed and sent through a pipe); the others answer `render()` with None, and `call("render")`
+  returns the filmed ones' frames alone, so that lerobot-eval films `min(filmed_envs, 10)` episodes.
 """
 
 from __future__ import annotations
@@ -76,6 +77,7 @@ class LazyAsyncVectorEnv:
     def __init__(self, factories: list[Callable[[], gym.Env]], observation_space: gym.Space,
                  action_space: gym.Space, metadata: dict, filmed_envs: int = 10):
         self._factories = [Frozen(factory, filmed=index < filmed_envs) for index, factory in enumerate(factories)]
+        self._filmed_envs = filmed_envs
         self._env: gym.vector.AsyncVectorEnv | None = None
         self.num_envs = len(factories)
         self.observation_space = self.single_observation_space = observation_space
@@ -99,7 +101,10 @@ class LazyAsyncVectorEnv:
         return self._started().step(actions)
 
     def call(self, name: str, *args, **kwargs):
-        return self._started().call(name, *args, **kwargs)
+        """Each sub-env's `name(*args, **kwargs)`; for "render", only the frames of the filmed sub-envs (the
+        first ones), so that lerobot-eval stacks and films as many episodes as draw frames."""
+        results = self._started().call(name, *args, **kwargs)
+        return results[:self._filmed_envs] if name == "render" else results
 
     def get_attr(self, name: str):
         return self._started().get_attr(name)

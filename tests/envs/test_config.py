@@ -87,14 +87,17 @@ def test_async_create_envs_run_in_forkserver_workers():
 
 
 def test_only_the_filmed_sub_envs_of_an_async_batch_draw_frames():
-    """lerobot-eval asks every async sub-env for a frame each step but films only its first ones."""
+    """lerobot-eval asks every async sub-env for a frame each step: only the first `filmed_envs` draw one, and only
+    theirs come back, so that lerobot-eval films as many episodes."""
     config = TavisEnvConfig(task="wait_then_act", image_size=(24, 32), filmed_envs=1)
     vec = config.create_envs(n_envs=3, use_async_envs=True)["tavis_head"][0]
     vec.reset(seed=[1000, 1001, 1002], options={NEW_ROLLOUT_OPTION: True})
     frames = vec.call("render")
+    unfilmed = vec._started().call("render")[1:]
     vec.close()
+    assert len(frames) == 1
     assert frames[0].ndim == 3 and frames[0].dtype == np.uint8 and frames[0].shape[0] > 24  # overview + views
-    assert frames[1:] == (None, None)
+    assert unfilmed == (None, None)  # drawn by nobody
 
 
 def test_a_negative_filmed_env_count_is_refused():

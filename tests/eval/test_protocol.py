@@ -192,15 +192,18 @@ def test_a_negative_film_count_is_refused(tmp_path):
         ProtocolConfig(out_dir=tmp_path, expert=True, film_episodes=-1)
 
 
-def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path):
+@pytest.mark.parametrize("envs, videos", [(["--eval.use_async_envs=false"], 2),
+                                          (["--eval.use_async_envs=true", "--env.filmed_envs=1"], 1)])
+def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path, envs, videos):
     command = [os.path.join(os.path.dirname(sys.executable), "lerobot-eval"), "--env.type=tavis",
                "--env.task=conditional_pick", "--env.image_size=[32, 48]", "--env.episode_length_s=0.5",
                "--policy.type=diffusion", "--policy.pretrained_backbone_weights=null", "--policy.device=cpu",
                "--policy.down_dims=[16, 32, 64]", "--policy.num_inference_steps=2", "--eval.n_episodes=2",
-               "--eval.batch_size=2", "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'out'}"]
+               "--eval.batch_size=2", *envs, f"--output_dir={tmp_path / 'out'}"]
     subprocess.run(command, check=True, capture_output=True, text=True, env={**os.environ, "HF_HUB_OFFLINE": "1"})
     info = json.loads((tmp_path / "out" / "eval_info.json").read_text())
     assert info["per_task"][0]["task_group"] == "tavis_head"
+    assert len(info["overall"]["video_paths"]) == videos
     records = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
     assert sorted(r["seed"] for r in records) == [1000, 1001]
     assert all("galt_s" in r and r["length_steps"] == 10 for r in records)
