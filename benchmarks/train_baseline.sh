@@ -8,7 +8,9 @@
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
 # demonstrations, as many as the reference's datasets hold per task), STEPS, SAVE_FREQ and BATCH (the preset's, 6000,
 # 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), FILM
-# (episodes filmed per evaluation: 2, as each filmed sub-env also renders the overview), WORK (/tmp/tavis_baseline).
+# (episodes filmed per evaluation: 2, as each filmed sub-env also renders the overview), EVAL_OPTIONS (more
+# lerobot-eval arguments, e.g. "--policy.temporal_ensemble_coeff=0.01 --policy.n_action_steps=1" for ACT's temporal
+# ensembling) and EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
@@ -34,6 +36,8 @@ EPISODES=${EPISODES:-160}
 WORKERS=${WORKERS:-$(nproc)}
 EVAL_EPISODES=${EVAL_EPISODES:-96}
 FILM=${FILM:-2}
+EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
+read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 WORK=${WORK:-/tmp/tavis_baseline}
 export MUJOCO_GL=${MUJOCO_GL:-egl}
 case "$CONDITION" in
@@ -72,7 +76,7 @@ evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES
   lerobot-eval --policy.path="$1/pretrained_model" --policy.device=cuda --policy.use_amp=true --env.type=tavis \
     --env.task="$TASK" --env.robot="$ROBOT" --env.camera_mode="$CONDITION" --env.image_size="[${SIZE/x/,}]" \
     --seed="$3" --eval.n_episodes="$4" --eval.batch_size=$(( $4 < 48 ? $4 : 48 )) --eval.use_async_envs=true \
-    --env.filmed_envs="$FILM" --output_dir="$2"
+    --env.filmed_envs="$FILM" "${eval_options[@]}" --output_dir="$2"
   tavis report "$2"
 }
 
@@ -119,7 +123,7 @@ case "${1:-}" in
     last=$(basename "$link")
     for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
       (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
-      out="$WORK/eval_$CONDITION/step_$((10#$(basename "$checkpoint")))"
+      out="$WORK/$EVAL_NAME/step_$((10#$(basename "$checkpoint")))"
       [ -f "$out/eval_info.json" ] && continue
       mkdir -p "$(dirname "$out")"
       mkdir "$out.running" 2>/dev/null || continue  # another eval call has it
