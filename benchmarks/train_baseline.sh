@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact ACT policy -> evaluation
-# of every checkpoint (96 episodes each, Wilson intervals and GALT by `tavis report`).
+# of every checkpoint (96 episodes each, Wilson intervals and GALT by `tavis eval`'s report).
 #
 #   benchmarks/train_baseline.sh pair|cell|data|train|eval|overfit
 #
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
 # demonstrations, as many as the reference's datasets hold per task), STEPS, SAVE_FREQ and BATCH (the preset's, 6000,
-# 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), FILM
-# (episodes filmed per evaluation: 2, as each filmed sub-env also renders the overview), EVAL_OPTIONS (more
-# lerobot-eval arguments, e.g. "--policy.temporal_ensemble_coeff=0.01 --policy.n_action_steps=1" for ACT's temporal
+# 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), EVAL_JOBS
+# (4: an evaluation's jobs sharing the GPU, each a batch of EVAL_EPISODES / EVAL_JOBS envs), FILM (episodes filmed
+# per evaluation: 2, as each filmed sub-env also renders the overview), EVAL_OPTIONS (more `tavis eval` arguments,
+# e.g. "--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1" for ACT's temporal
 # ensembling) and EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
@@ -22,9 +23,10 @@
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
 #   libraries can be found (PyAV's bundled copy, tools/pyav_ffmpeg.sh), else with PyAV.
-# - eval: lerobot-eval on every complete checkpoint not yet evaluated (seeds from 1000), side by side, then
-#   `tavis report`; it can run beside `train`, which marks a checkpoint complete by pointing `checkpoints/last` at
-#   it, and beside another `eval` call, which skips the checkpoints that one is evaluating.
+# - eval: `tavis eval --policy` (LeRobot's evaluation loop, EVAL_JOBS runs of it sharing the GPU: one run's
+#   Python loop over a batch of 48 envs kept 16 cores far from busy) on every complete checkpoint not yet evaluated
+#   (seeds from 1000), side by side; it can run beside `train`, which marks a checkpoint complete by pointing
+#   `checkpoints/last` at it, and beside another `eval` call, which skips the checkpoints that one is evaluating.
 # - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (3000) and
 #   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
 #   on points at a data or alignment bug, not at too little training.
@@ -35,6 +37,7 @@ ROBOT=${ROBOT:-gr1t2}
 EPISODES=${EPISODES:-160}
 WORKERS=${WORKERS:-$(nproc)}
 EVAL_EPISODES=${EVAL_EPISODES:-96}
+EVAL_JOBS=${EVAL_JOBS:-4}
 FILM=${FILM:-2}
 EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
@@ -72,12 +75,12 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]
     --log_freq=100 --output_dir="$out" "$@"
 }
 
-evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES
-  lerobot-eval --policy.path="$1/pretrained_model" --policy.device=cuda --policy.use_amp=true --env.type=tavis \
-    --env.task="$TASK" --env.robot="$ROBOT" --env.camera_mode="$CONDITION" --env.image_size="[${SIZE/x/,}]" \
-    --seed="$3" --eval.n_episodes="$4" --eval.batch_size=$(( $4 < 48 ? $4 : 48 )) --eval.use_async_envs=true \
-    --env.filmed_envs="$FILM" "${eval_options[@]}" --output_dir="$2"
-  tavis report "$2"
+evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the id split of TASK
+  local per_job=$(( ($4 + EVAL_JOBS - 1) / EVAL_JOBS ))
+  tavis eval --policy "$1/pretrained_model" --tasks "$TASK" --splits id --episodes "$4" --seed "$3" --robot "$ROBOT" \
+    --camera-mode "$CONDITION" --image-size "$SIZE" --device cuda --policy-option use_amp=true \
+    --workers "$EVAL_JOBS" --chunk-episodes "$per_job" --batch-size "$per_job" --film-episodes "$FILM" \
+    "${eval_options[@]}" --out "$2"
 }
 
 case "${1:-}" in
@@ -124,7 +127,7 @@ case "${1:-}" in
     for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
       (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
       out="$WORK/$EVAL_NAME/step_$((10#$(basename "$checkpoint")))"
-      [ -f "$out/eval_info.json" ] && continue
+      [ -f "$out/results.json" ] && continue
       mkdir -p "$(dirname "$out")"
       mkdir "$out.running" 2>/dev/null || continue  # another eval call has it
       ( trap 'rmdir "$out.running"' EXIT; time evaluate "$checkpoint" "$out" 1000 "$EVAL_EPISODES" ) &

@@ -32,7 +32,7 @@ from tqdm import tqdm
 from lerobot_tavis.atomic import write_text
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.dataset_tools.workers import executor
-from lerobot_tavis.envs.tasks.catalog import expand_tasks
+from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
@@ -90,11 +90,15 @@ def run_cells(cfg, cells: Sequence) -> None:
 
 
 def _chunks(cfg, cell) -> list[Chunk]:
-    tasks = expand_tasks(cell.suite)[cell.suite]
     last = cfg.seed + cfg.n_episodes
     size = cfg.chunk_size
     return [Chunk(cell.name, cell.suite, cell.split, task_id, task, first, min(size, last - first))
-            for task_id, task in enumerate(tasks) for first in range(cfg.seed, last, size)]
+            for task_id, task in played_tasks(cfg, cell.suite) for first in range(cfg.seed, last, size)]
+
+
+def played_tasks(cfg, suite: str) -> list[tuple[int, str]]:
+    """(index in the suite, name) of the tasks of `suite` a run plays: all of them, or those of `cfg.tasks`."""
+    return [(task_id, task) for task_id, task in enumerate(suite_tasks(suite)) if not cfg.tasks or task in cfg.tasks]
 
 
 def _completed(cfg, fn: Callable, jobs: list[tuple]) -> Iterator:

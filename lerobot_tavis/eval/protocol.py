@@ -20,9 +20,10 @@ from lerobot_tavis.dataset_tools.workers import BACKENDS
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, RENAMED_MODES, camera_mode_names, resolve_camera_mode
 from lerobot_tavis.envs.physics import POLICY_HZ
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
-from lerobot_tavis.envs.tasks.catalog import PROTOCOL_SPLITS, SUITES, split_names
+from lerobot_tavis.envs.tasks.catalog import (BENCHMARK_TASKS, PROTOCOL_SPLITS, SUITES, split_names, suite_tasks,
+                                              task_info)
 from lerobot_tavis.errors import FieldError, InputError
-from lerobot_tavis.eval.cell_runs import policy_config, run_cells
+from lerobot_tavis.eval.cell_runs import played_tasks, policy_config, run_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
 START_SEED = 1000
@@ -65,7 +66,10 @@ class ProtocolConfig:
     policy_path: str | None = option(None, "policy checkpoint directory (pretrained_model)", flag="--policy")
     expert: bool = option(False, "evaluate the scripted demonstrators instead")
     robot: str | None = option(None, f"default: the checkpoint's, else {DEFAULT_ROBOT}", choices=robot_names)
-    suites: tuple[str, ...] = option(SUITES[:1], flag="--suite", choices=SUITES)
+    suites: tuple[str, ...] | None = option(None, f"default: the suites of --tasks, else {SUITES[0]}", flag="--suite",
+                                            choices=SUITES)
+    tasks: tuple[str, ...] = option((), "only these tasks of the suites (default: all of them), e.g. the task of a "
+                                    "single-task policy", choices=BENCHMARK_TASKS)
     splits: tuple[str, ...] = option(PROTOCOL_SPLITS, "default: the reference's id ood_spatial ood_init_pose; also "
                                      "ood_visual (the look changed) and ood_visual:<factor> for one factor alone",
                                      choices=split_names)
@@ -101,6 +105,12 @@ class ProtocolConfig:
             if getattr(self, name) is None:
                 object.__setattr__(self, name, trained.get(name, default))
         object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
+        if self.suites is None:
+            object.__setattr__(self, "suites", tuple(dict.fromkeys(task_info(task).suite for task in self.tasks))
+                               or SUITES[:1])
+        outside = [task for task in self.tasks if not any(task in suite_tasks(suite) for suite in self.suites)]
+        if outside:
+            raise FieldError("tasks", f"{outside} are not tasks of the suites {list(self.suites)}: name their suite too")
         checks.integer("n_episodes", self.n_episodes, 1)
         checks.integer("batch_size", self.batch_size, 1)
         checks.integer("workers", self.workers, 1)
@@ -157,13 +167,18 @@ def _trained_env(policy_path: str) -> dict:
 
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:
     cfg.out_dir.mkdir(parents=True, exist_ok=True)
-    cells = [Cell(suite, split) for split in cfg.splits for suite in cfg.suites]
+    cells = [Cell(suite, split) for split in cfg.splits for suite in cfg.suites if played_tasks(cfg, suite)]
     pending = []
     for cell in cells:
-        if (cfg.out_dir / cell.name / EVAL_INFO_NAME).exists():
-            print(f"{cell.name}: done already, skipped")
-        else:
+        info = cfg.out_dir / cell.name / EVAL_INFO_NAME
+        if not info.exists():
             pending.append(cell)
+            continue
+        held = [task["task_id"] for task in json.loads(info.read_text())["per_task"]]
+        if held != [task_id for task_id, _ in played_tasks(cfg, cell.suite)]:
+            raise InputError(f"{info.parent} holds the tasks {[suite_tasks(cell.suite)[i] for i in held]}, not those "
+                             "asked for: give another --out")
+        print(f"{cell.name}: done already, skipped")
     if cfg.policy_path is not None:
         policy_config(cfg)  # a bad --policy-option fails here, before any job starts
     run_cells(cfg, pending)

@@ -11,7 +11,7 @@ import pytest
 from lerobot_tavis.cli import main
 from lerobot_tavis.eval import protocol
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
-from lerobot_tavis.errors import FieldError
+from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
 
 
@@ -33,6 +33,27 @@ def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
     assert "tavis_hands__id: done already, skipped" in capsys.readouterr().out
     assert (cell / "eval_info.json").stat().st_mtime_ns == before
     assert not list(tmp_path.glob(".*partial*"))
+
+
+def test_tasks_play_only_those_tasks_and_a_cell_of_other_tasks_is_not_reused(tmp_path):
+    cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", splits=("id",), tasks=("occluded_reach",),
+                         n_episodes=2, image_size=(24, 32))
+    assert cfg.suites == ("tavis_hands",)  # the task's suite
+    run_protocol(cfg)
+    assert [path.name for path in tmp_path.glob("*__*")] == ["tavis_hands__id"]
+    cell = tmp_path / "tavis_hands__id"
+    info = json.loads((cell / "eval_info.json").read_text())
+    assert [t["task_id"] for t in info["per_task"]] == [suite_tasks("tavis_hands").index("occluded_reach")]
+    records = [json.loads(line) for line in (cell / "episodes.jsonl").read_text().splitlines()]
+    assert [(r["task"], r["seed"]) for r in records] == [("occluded_reach", 1000), ("occluded_reach", 1001)]
+    with pytest.raises(InputError, match="holds the tasks \\['occluded_reach'\\], not those asked for"):
+        run_protocol(ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",),
+                                    splits=("id",), n_episodes=2, image_size=(24, 32)))
+
+
+def test_a_task_outside_the_suites_is_refused(tmp_path):
+    with pytest.raises(FieldError, match="tasks \\['conditional_pick'\\] are not tasks of the suites"):
+        ProtocolConfig(out_dir=tmp_path, expert=True, suites=("tavis_hands",), tasks=("conditional_pick",))
 
 
 def _cell_files(root, cell="tavis_hands__id"):
