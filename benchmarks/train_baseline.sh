@@ -90,7 +90,9 @@ case "${1:-}" in
     else mapfile -t gpus < <(nvidia-smi --query-gpu=index --format=csv,noheader 2>/dev/null || true); fi
     index=0
     for condition in head_wrist fixed_wrist; do
-      ( if (( ${#gpus[@]} > 1 )); then export CUDA_VISIBLE_DEVICES=${gpus[index % ${#gpus[@]}]}; fi
+      ( if (( ${#gpus[@]} > 1 )); then  # MuJoCo's EGL follows CUDA_VISIBLE_DEVICES only where the driver maps them
+          export CUDA_VISIBLE_DEVICES=${gpus[index % ${#gpus[@]}]} MUJOCO_EGL_DEVICE_ID=${gpus[index % ${#gpus[@]}]}
+        fi
         CONDITION=$condition WORKERS=$(( WORKERS > 1 ? WORKERS / 2 : 1 )) "$0" cell > "$WORK/cell_$condition.log" 2>&1
       ) &
       index=$(( index + 1 ))
