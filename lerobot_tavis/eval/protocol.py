@@ -110,7 +110,8 @@ class ProtocolConfig:
                                or SUITES[:1])
         outside = [task for task in self.tasks if not any(task in suite_tasks(suite) for suite in self.suites)]
         if outside:
-            raise FieldError("tasks", f"{outside} are not tasks of the suites {list(self.suites)}: name their suite too")
+            raise FieldError("tasks", f"{outside} are not tasks of the suites {list(self.suites)}: "
+                                      "name their suite too")
         checks.integer("n_episodes", self.n_episodes, 1)
         checks.integer("batch_size", self.batch_size, 1)
         checks.integer("workers", self.workers, 1)
