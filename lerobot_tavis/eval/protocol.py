@@ -1,7 +1,7 @@
 """`tavis eval`: the benchmark protocol for one policy checkpoint (or the demonstrators) on one robot.
 
-Cells are suite x split (`id`, `ood_spatial`, `ood_init_pose`), 96 episodes per task by default, seeds from 1000
-as lerobot-eval uses them. Policy and demonstrators alike play (cell, task, seed chunk) jobs over all workers
+Cells are suite x split (`id`, `ood_spatial`, `ood_init_pose`), 96 episodes per task (all of the suite's, or those
+of `--tasks`) by default, seeds from 1000 as lerobot-eval uses them. Policy and demonstrators alike play (cell, task, seed chunk) jobs over all workers
 (`cell_runs`): a policy chunk is one lerobot-eval run in a worker process, so several share one GPU; the
 demonstrators play through the same env and episode log. Finished chunks survive a kill and each cell is moved
 into place when complete, so a re-run skips finished cells and chunks. `wall_clock_s.txt` in a cell is the time
@@ -61,7 +61,8 @@ ENV_DEFAULTS = {"robot": DEFAULT_ROBOT, "camera_mode": DEFAULT_CAMERA_MODE, "ima
 @dataclass(frozen=True, kw_only=True)
 class ProtocolConfig:
     """The protocol run of `tavis eval`; also its command-line options. Exactly one of `policy_path` and `expert`;
-    `robot`, `camera_mode` and `image_size` left None are the checkpoint's, else ENV_DEFAULTS."""
+    `robot`, `camera_mode` and `image_size` left None are the checkpoint's, else ENV_DEFAULTS; `suites` left None
+    are those of `tasks`, else the first of SUITES."""
 
     policy_path: str | None = option(None, "policy checkpoint directory (pretrained_model)", flag="--policy")
     expert: bool = option(False, "evaluate the scripted demonstrators instead")
