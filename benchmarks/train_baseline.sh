@@ -8,10 +8,11 @@
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
 # demonstrations, as many as the reference's datasets hold per task), STEPS, SAVE_FREQ and BATCH (the preset's, 6000,
 # 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), EVAL_JOBS
-# (4: an evaluation's jobs sharing the GPU, each a batch of EVAL_EPISODES / EVAL_JOBS envs), FILM (episodes filmed
-# per evaluation: 2, as each filmed sub-env also renders the overview), EVAL_OPTIONS (more `tavis eval` arguments,
-# e.g. "--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1" for ACT's temporal
-# ensembling) and EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), WORK (/tmp/tavis_baseline).
+# and EVAL_BATCH (4 and 12: an evaluation's jobs sharing the GPU, each playing EVAL_EPISODES / EVAL_JOBS episodes
+# in batches of EVAL_BATCH envs), FILM (episodes filmed per evaluation: 2, as each filmed sub-env also renders the
+# overview), EVAL_OPTIONS (more `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01
+# --policy-option n_action_steps=1" for ACT's temporal ensembling) and EVAL_NAME (the evaluations' folder under
+# WORK: eval_<CONDITION>), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
@@ -38,6 +39,7 @@ EPISODES=${EPISODES:-160}
 WORKERS=${WORKERS:-$(nproc)}
 EVAL_EPISODES=${EVAL_EPISODES:-96}
 EVAL_JOBS=${EVAL_JOBS:-4}
+EVAL_BATCH=${EVAL_BATCH:-12}
 FILM=${FILM:-2}
 EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
@@ -79,8 +81,8 @@ evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the id s
   local per_job=$(( ($4 + EVAL_JOBS - 1) / EVAL_JOBS ))
   tavis eval --policy "$1/pretrained_model" --tasks "$TASK" --splits id --episodes "$4" --seed "$3" --robot "$ROBOT" \
     --camera-mode "$CONDITION" --image-size "$SIZE" --device cuda --policy-option use_amp=true \
-    --workers "$EVAL_JOBS" --chunk-episodes "$per_job" --batch-size "$per_job" --film-episodes "$FILM" \
-    "${eval_options[@]}" --out "$2"
+    --workers "$EVAL_JOBS" --chunk-episodes "$per_job" --batch-size $(( per_job < EVAL_BATCH ? per_job : EVAL_BATCH )) \
+    --film-episodes "$FILM" "${eval_options[@]}" --out "$2"
 }
 
 case "${1:-}" in
