@@ -1,0 +1,55 @@
+"""benchmarks/train_baseline.sh's orchestration, run with stand-ins for tavis and lerobot-train that record how
+they were called: which GPU each condition gets, and that every checkpoint is evaluated once."""
+
+import os
+import re
+import subprocess
+from pathlib import Path
+
+SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "train_baseline.sh"
+
+# Each stand-in logs "<tool> <arguments> | gpu=<CUDA_VISIBLE_DEVICES> egl=<MUJOCO_EGL_DEVICE_ID>".
+LOG_CALL = 'echo "$(basename "$0") $* | gpu=${CUDA_VISIBLE_DEVICES:-} egl=${MUJOCO_EGL_DEVICE_ID:-}" >> "$CALLS"\n'
+TAVIS = LOG_CALL + """case $1 in
+  record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
+  presets) echo /dev/null ;;
+  eval) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/results.json" ;;
+esac
+"""
+LEROBOT_TRAIN = LOG_CALL + """for arg in "$@"; do case $arg in --output_dir=*) out=${arg#*=} ;; esac; done
+for step in 001500 003000; do mkdir -p "$out/checkpoints/$step"; ln -sfn $step "$out/checkpoints/last"; done
+"""
+
+
+def _run(tmp_path, mode, **settings) -> list[str]:
+    stubs = tmp_path / "bin"
+    stubs.mkdir()
+    for name, body in (("tavis", TAVIS), ("lerobot-train", LEROBOT_TRAIN)):
+        (stubs / name).write_text("#!/usr/bin/env bash\n" + body)
+        (stubs / name).chmod(0o755)
+    env = {**os.environ, "PATH": f"{stubs}:{os.environ['PATH']}", "CALLS": str(tmp_path / "calls.log"),
+           "WORK": str(tmp_path / "work"), "WORKERS": "4", "TRAIN_S": "60", **settings}
+    subprocess.run(["bash", str(SCRIPT), mode], env=env, check=True, capture_output=True, timeout=300)
+    return (tmp_path / "calls.log").read_text().splitlines()
+
+
+def test_pair_trains_each_condition_on_its_own_visible_gpu_and_evaluates_every_checkpoint_once(tmp_path):
+    calls = _run(tmp_path, "pair", CUDA_VISIBLE_DEVICES="2,3")
+    assert sum(call.startswith("tavis record") for call in calls) == 1  # both conditions share the recording
+    trains = sorted((re.search(r"--output_dir=\S*/train_(\w+)", call)[1], call.split(" | ")[1])
+                    for call in calls if call.startswith("lerobot-train"))
+    assert trains == [("fixed_wrist", "gpu=3 egl=3"), ("head_wrist", "gpu=2 egl=2")]
+    evals = sorted(call.split(" --out ")[1] for call in calls if call.startswith("tavis eval"))
+    work = tmp_path / "work"
+    assert evals == [f"{work}/eval_{condition}/step_{step} | gpu={gpu} egl={gpu}"
+                     for condition, gpu in (("fixed_wrist", 3), ("head_wrist", 2)) for step in (1500, 3000)]
+    assert all("--tasks conditional_pick --splits id --episodes 96" in call for call in calls if "tavis eval" in call)
+
+
+def test_eval_options_reach_tavis_eval_and_its_folder_is_eval_name(tmp_path):
+    calls = _run(tmp_path, "cell", EVAL_NAME="eval_te",
+                 EVAL_OPTIONS="--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1")
+    evals = sorted(call.split(" | ")[0] for call in calls if call.startswith("tavis eval"))
+    assert len(evals) == 2
+    assert all(call.endswith("--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1 "
+                             f"--out {tmp_path}/work/eval_te/step_{step}") for call, step in zip(evals, (1500, 3000)))
