@@ -33,9 +33,9 @@ case "${1:-}" in
     python3 - "$WORK/dataset/meta/stats.json" <<'PY'
 import json, sys
 stats = json.load(open(sys.argv[1]))["observation.state"]
-constant = [i for i, (low, high) in enumerate(zip(stats["min"], stats["max"])) if high <= low]
+constant = [i for i, (low, high) in enumerate(zip(stats["min"], stats["max"])) if high - low < 1e-6]
 if constant:
-    sys.exit(f"checkpoint: state dimensions {constant} never change in the probe's demonstrations")
+    sys.exit(f"checkpoint: state dimensions {constant} never change (by 1e-6) in the probe's demonstrations")
 PY
     lerobot-train --config_path="$(tavis presets diffusion_head_wrist)" --dataset.repo_id=local/protocol-probe \
       --dataset.root="$WORK/dataset" --policy.device="${DEVICE:-cuda}" --steps=1 --save_freq=1 --batch_size=2 \
