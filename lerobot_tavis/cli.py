@@ -5,6 +5,7 @@ the subcommands."""
 from __future__ import annotations
 
 import argparse
+import importlib
 import signal
 import sys
 import threading
@@ -54,25 +55,16 @@ class ReportOptions:
                             positional=True)
 
 
-def _demo(cfg) -> None:
-    from lerobot_tavis.demo import run_demo
+def _printing(target: str):
+    """A subcommand's run: call `target` ("module:function", imported only when the subcommand runs) with the
+    options and print each line it returns (written files, messages)."""
+    module, _, name = target.partition(":")
 
-    for path in run_demo(cfg):
-        print(path)
+    def run(cfg) -> None:
+        for line in getattr(importlib.import_module(module), name)(cfg):
+            print(line)
 
-
-def _gallery(cfg) -> None:
-    from lerobot_tavis.gallery import write_gallery
-
-    for path in write_gallery(cfg):
-        print(path)
-
-
-def _eval(cfg) -> None:
-    from lerobot_tavis.eval.protocol import run_protocol
-
-    for path in run_protocol(cfg):
-        print(path)
+    return run
 
 
 def _report(options: ReportOptions) -> None:
@@ -87,13 +79,6 @@ def _record(cfg) -> None:
 
     for task, count in record(cfg).counts().items():
         print(f"{task}: {count['kept']} kept, {count['discarded']} discarded")
-
-
-def _teleop(cfg) -> None:
-    from lerobot_tavis.teleop import teleop
-
-    for line in teleop(cfg):
-        print(line)
 
 
 def _view(cfg) -> None:
@@ -165,15 +150,15 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tavis", description="TAVIS active-vision benchmark in MuJoCo")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=CommandParser)
     for name, options, run, help in (
-        ("demo", "lerobot_tavis.demo:DemoConfig", _demo,
+        ("demo", "lerobot_tavis.demo:DemoConfig", _printing("lerobot_tavis.demo:run_demo"),
          "one demonstrator episode per task and robot: MP4 of the four views"),
-        ("gallery", "lerobot_tavis.gallery:GalleryConfig", _gallery,
+        ("gallery", "lerobot_tavis.gallery:GalleryConfig", _printing("lerobot_tavis.gallery:write_gallery"),
          "stills of every task and robot (first observation, grasp) and the README overview figure"),
-        ("eval", "lerobot_tavis.eval.protocol:ProtocolConfig", _eval,
+        ("eval", "lerobot_tavis.eval.protocol:ProtocolConfig", _printing("lerobot_tavis.eval.protocol:run_protocol"),
          "the 96-episode protocol for a policy checkpoint or the demonstrators"),
         ("record", "lerobot_tavis.dataset_tools.record:RecordConfig", _record,
          "record scripted demonstrations at 60 Hz (replayable raw episodes)"),
-        ("teleop", "lerobot_tavis.teleop:TeleopConfig", _teleop,
+        ("teleop", "lerobot_tavis.teleop:TeleopConfig", _printing("lerobot_tavis.teleop:teleop"),
          "drive the robot with the keyboard and record raw episodes (a window)"),
         ("view", "lerobot_tavis.viewer:ViewConfig", _view, "MuJoCo's interactive viewer on one episode (a window)"),
         ("convert", "lerobot_tavis.dataset_tools.convert:ConvertConfig", _convert,

@@ -36,8 +36,8 @@ from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import split_names, task_names
 from lerobot_tavis.errors import TavisError
-from lerobot_tavis.viewer import (FREE_CAMERA, KEY_BACKSPACE, KEY_DOWN, KEY_ENTER, KEY_LEFT, KEY_RIGHT, KEY_SPACE,
-                                  KEY_TAB, KEY_UP, WINDOW_CAMERAS)
+from lerobot_tavis.viewer import (KEY_BACKSPACE, KEY_DOWN, KEY_ENTER, KEY_LEFT, KEY_RIGHT, KEY_SPACE, KEY_TAB, KEY_UP,
+                                  WINDOW_CAMERAS)
 
 HAND_STEP_M = 0.01
 HEAD_STEP_RAD = 0.05
@@ -188,7 +188,7 @@ def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
     try:
         if keys is None:
             env.reset(seed=seed)
-            window = Window(env, None if cfg.view == FREE_CAMERA else cfg.view)
+            window = Window(env, cfg.view)
             keys, show = window.keys, window.show
         while manifest.kept(cfg.task) < cfg.episodes and (window is None or window.running):
             ending, success, actions, states = teleop_episode(env, seed, keys, show, gamepad)

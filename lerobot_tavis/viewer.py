@@ -48,9 +48,9 @@ def require_display(command: str) -> None:
 class Window:
     """MuJoCo's passive viewer on a TavisEnv's model and data, paced at CONTROL_HZ; key presses (GLFW codes) queue
     up until `keys()` takes them. `camera` (a camera name of the env's world, e.g. "head") fixes the view to it;
-    None leaves the free camera. `rate_hz`: frames per second of wall time."""
+    FREE_CAMERA leaves the free camera. `rate_hz`: frames per second of wall time."""
 
-    def __init__(self, env, camera: str | None = None, rate_hz: float = CONTROL_HZ):
+    def __init__(self, env, camera: str = FREE_CAMERA, rate_hz: float = CONTROL_HZ):
         import mujoco
         import mujoco.viewer
 
@@ -59,7 +59,7 @@ class Window:
         self._handle = mujoco.viewer.launch_passive(env.model, env.data, key_callback=self._pressed.put,
                                                     show_left_ui=False, show_right_ui=False)
         self._ui_threads = set(threading.enumerate()) - before  # the viewer's own, which draws the window
-        if camera is not None:
+        if camera != FREE_CAMERA:
             self._handle.cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
             self._handle.cam.fixedcamid = env.world.cameras[camera]
         self._period_s = 1.0 / rate_hz
@@ -183,7 +183,7 @@ def view(cfg: ViewConfig) -> int:
         return observation, expert
 
     observation, expert = start()
-    window = Window(env, None if cfg.camera == FREE_CAMERA else cfg.camera, rate_hz=fps)
+    window = Window(env, cfg.camera, rate_hz=fps)
     try:
         while window.running and (cfg.max_frames is None or frames < cfg.max_frames):
             restart = False
