@@ -17,9 +17,10 @@
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
 #   comparison); logs in $WORK/cell_<condition>.log.
-# - cell: the whole cell within one 30-minute GPU slot: data, then training stopped after TRAIN_S seconds (780)
-#   with BATCH 128 and SAVE_FREQ 1500 unless set (loaders: WORKERS - 2), the checkpoints evaluated at low CPU
-#   priority as they appear, and those left after training ends side by side.
+# - cell: the whole cell within one 30-minute GPU slot: data, then STEPS (4800) steps of BATCH 128 with SAVE_FREQ
+#   1600 unless set (loaders: WORKERS - 2; the preset anneals the lr to 0 at the last step, about 13 minutes on
+#   one H100 with 16 cores; TRAIN_S, 960 s, only guards the slot), the checkpoints evaluated at low CPU priority as
+#   they appear, and those left after training ends side by side.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
@@ -105,8 +106,8 @@ case "${1:-}" in
     "$0" data
     stopped="$WORK/train_$CONDITION.stopped"
     rm -f "$stopped"
-    ( BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1500} STEPS=${STEPS:-1000000} \
-        WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-780}" "$0" train || true
+    ( BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1600} STEPS=${STEPS:-4800} \
+        WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-960}" "$0" train || true
       touch "$stopped" ) &
     ( while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
         nice -n 15 "$0" eval

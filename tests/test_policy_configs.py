@@ -84,6 +84,23 @@ def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_r
         assert str(cfg.policy.pretrained_path) == "lerobot/pi0_base"
 
 
+@pytest.mark.parametrize("name", ["act_head_wrist_compact", "act_fixed_wrist_compact"])
+def test_compact_presets_anneal_the_learning_rate_to_zero_at_the_last_step(name):
+    import torch
+    from lerobot.optim.factory import make_optimizer_and_scheduler
+
+    cfg = _parse(name, "--steps=40")
+    optimizer, scheduler = make_optimizer_and_scheduler(cfg, torch.nn.Linear(2, 2))
+    rates = []
+    for _ in range(cfg.steps + 1):
+        rates.append(optimizer.param_groups[0]["lr"])
+        optimizer.step()
+        scheduler.step()
+    assert rates[0] == pytest.approx(1e-4) and rates[20] == pytest.approx(5e-5) and rates[40] == pytest.approx(0.0)
+    assert all(later <= earlier for earlier, later in zip(rates, rates[1:]))
+    assert (optimizer.defaults["weight_decay"], cfg.optimizer.grad_clip_norm) == (1e-4, 10.0)
+
+
 def test_zero_neck_conversion_for_the_fixed_camera_presets(dataset_root, tmp_path):
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 

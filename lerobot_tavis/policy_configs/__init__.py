@@ -16,8 +16,10 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
   first and says what is missing.
 - Compact presets (`act_head_wrist_compact`, `act_fixed_wrist_compact`: the paper's two camera conditions) are not
   the reference's: ACT sized to train a baseline within one 30-minute GPU slot (120x160 frames, a ResNet-18 from
-  random weights, a chunk of 20 of which 10 are executed, batch 64, 6000 steps). A compact Diffusion Policy of the
-  same budget did not reproduce even its own training episodes (docs/results/README.md), ACT does.
+  random weights, a chunk of 20 of which 10 are executed, batch 64, 6000 steps, AdamW at lr 1e-4 annealed along a
+  cosine to 0 at the last of `--steps`, so a run's last checkpoint is its settled one: set `--steps` to the budget,
+  not past it). A compact Diffusion Policy of the same budget did not reproduce even its own training episodes
+  (docs/results/README.md), ACT does.
 
 The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
 keeps the two in step.
@@ -43,6 +45,7 @@ COMPACT_MODES = ("head_wrist", "fixed_wrist")  # the paper's headcam and fixedca
 PI0_IMAGE_SIZE = (480, 640)  # pi0 resizes and pads every camera to 224x224 itself
 CHUNK, EXECUTED = 16, 8
 COMPACT_CHUNK, COMPACT_EXECUTED = 20, 10
+COMPACT_LR = 1e-4  # ACT's default peak, for the backbone as for the transformer
 
 
 def presets() -> dict[str, tuple[str, str, bool]]:
@@ -114,9 +117,14 @@ def _compact_act(camera_mode: str) -> dict:
             feature["shape"] = [3, *size]
     preset["policy"] = {"type": "act", "input_features": inputs, "chunk_size": COMPACT_CHUNK,
                         "n_action_steps": COMPACT_EXECUTED, "pretrained_backbone_weights": None,
-                        "optimizer_lr": 1e-4, "optimizer_lr_backbone": 1e-4, "push_to_hub": False}
+                        "optimizer_lr": COMPACT_LR, "optimizer_lr_backbone": COMPACT_LR, "push_to_hub": False}
     preset["env"]["image_size"] = size
-    return preset | {"batch_size": 64, "steps": 6000, "save_freq": 2000, "env_eval_freq": 0}
+    # ACT's own optimizer (AdamW, weight decay 1e-4, gradients clipped at norm 10) with a schedule added: the lr
+    # falls along a cosine from COMPACT_LR to 0 at the last step
+    schedule = {"use_policy_training_preset": False,
+                "optimizer": {"type": "adamw", "lr": COMPACT_LR, "weight_decay": 1e-4, "grad_clip_norm": 10.0},
+                "scheduler": {"type": "cosine_annealing_with_warmup", "num_warmup_steps": 0}}
+    return preset | schedule | {"batch_size": 64, "steps": 6000, "save_freq": 2000, "env_eval_freq": 0}
 
 
 def write_presets() -> list[Path]:
