@@ -12,9 +12,9 @@
 #   (2026-11-26, after 768 episodes).
 # - protocol: the protocol with that checkpoint (or CHECKPOINT), DDIM with STEPS (10) denoising steps and AMP on
 #   DEVICE (cuda), WORKERS (3) jobs sharing the GPU, BATCH (32) envs per job, FILM (4) filmed episodes per task
-#   and split; writes $WORK/protocol/ and $WORK/protocol_footprint.json. Few jobs with large batches: each job's
-#   denoising is a chain of small kernels, so the GPU's time goes per batch, not per episode (8 jobs of 12 kept
-#   the H100 99% busy and the 16 cores 26% busy).
+#   and split; writes $WORK/protocol/ and $WORK/protocol_footprint.json. 3 jobs of 32 and 8 jobs of 12 stepped
+#   about as many envs per second (505 and 550, a third of what 96 rendering env workers reach alone:
+#   docs/benchmarks.md), so the default is the one with fewer policy copies on the GPU.
 #
 # Settings (environment variables): WORK (/tmp/tavis_protocol), SPLITS ("id ood_spatial ood_init_pose"), EPISODES
 # (96), and those above.

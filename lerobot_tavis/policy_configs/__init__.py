@@ -18,8 +18,8 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
   the reference's: ACT sized to train a baseline within one 30-minute GPU slot (120x160 frames, a ResNet-18 from
   random weights, a chunk of 20 of which 10 are executed, batch 64, 6000 steps, AdamW at lr 1e-4 annealed along a
   cosine to 0 at the last of `--steps`, so a run's last checkpoint is its settled one: set `--steps` to the budget,
-  not past it). A compact Diffusion Policy of the same budget did not reproduce even its own training episodes
-  (docs/results/README.md), ACT does.
+  not past it; `--optimizer.lr` changes the peak). A compact Diffusion Policy of the same budget did not reproduce
+  even its own training episodes (docs/results/README.md), ACT does.
 
 The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
 keeps the two in step.
