@@ -100,6 +100,32 @@ def test_only_the_filmed_sub_envs_of_an_async_batch_draw_frames():
     assert unfilmed == (None, None)  # drawn by nobody
 
 
+def test_an_async_batch_asks_its_workers_for_the_prompts_once_per_reset():
+    """lerobot-eval asks for every sub-env's task_description at each step; the answer changes only at a reset."""
+    config = TavisEnvConfig(task="conditional_pick", image_size=(24, 32))
+    vec = config.create_envs(n_envs=2, use_async_envs=True)["tavis_head"][0]
+    vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+    workers = vec._started()
+    asked, ask_workers = [], workers.call
+
+    def counted(name, *args, **kwargs):
+        asked.append(name)
+        return ask_workers(name, *args, **kwargs)
+
+    workers.call = counted
+    try:
+        first = vec.call("task_description")
+        vec.step(np.tile(canonical.rest_action(), (2, 1)))
+        assert vec.call("task_description") == first == ask_workers("task_description")
+        assert asked == ["task_description"]
+        vec.reset(seed=[1002, 1003], options={NEW_ROLLOUT_OPTION: True})
+        assert vec.call("task_description") == ask_workers("task_description")
+        assert asked == ["task_description"] * 2
+        assert len(first) == 2 and all(prompt.startswith("Look at the card") for prompt in first)
+    finally:
+        vec.close()
+
+
 def test_a_negative_filmed_env_count_is_refused():
     with pytest.raises(ValueError, match="filmed_envs must be an integer >= 0"):
         TavisEnvConfig(filmed_envs=-1)
