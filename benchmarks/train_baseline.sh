@@ -11,8 +11,8 @@
 # and EVAL_BATCH (4 and 12: an evaluation's jobs sharing the GPU, each playing EVAL_EPISODES / EVAL_JOBS episodes
 # in batches of EVAL_BATCH envs), FILM (episodes filmed per evaluation: 2, as each filmed sub-env also renders the
 # overview), EVAL_OPTIONS (more `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01
-# --policy-option n_action_steps=1" for ACT's temporal ensembling) and EVAL_NAME (the evaluations' folder under
-# WORK: eval_<CONDITION>), WORK (/tmp/tavis_baseline).
+# --policy-option n_action_steps=1" for ACT's temporal ensembling), EVAL_NAME (the evaluations' folder under
+# WORK: eval_<CONDITION>), CHECKPOINTS (which `eval` takes: all, or last), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
@@ -43,6 +43,7 @@ EVAL_JOBS=${EVAL_JOBS:-4}
 EVAL_BATCH=${EVAL_BATCH:-12}
 FILM=${FILM:-2}
 EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
+CHECKPOINTS=${CHECKPOINTS:-all}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 WORK=${WORK:-/tmp/tavis_baseline}
 export MUJOCO_GL=${MUJOCO_GL:-egl}
@@ -50,6 +51,10 @@ case "$CONDITION" in
   head_wrist) CAMERAS=head,left_wrist,right_wrist; NECK=() ;;
   fixed_wrist) CAMERAS=fixed,left_wrist,right_wrist; NECK=(--zero-neck) ;;
   *) echo "CONDITION must be head_wrist or fixed_wrist, got '$CONDITION'" >&2; exit 2 ;;
+esac
+case "$CHECKPOINTS" in
+  all|last) ;;
+  *) echo "CHECKPOINTS must be all or last, got '$CHECKPOINTS'" >&2; exit 2 ;;
 esac
 SIZE=120x160
 HERE=$(cd "$(dirname "$0")" && pwd)
@@ -131,6 +136,7 @@ case "${1:-}" in
     last=$(basename "$link")
     for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
       (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
+      [ "$CHECKPOINTS" = all ] || [ "$(basename "$checkpoint")" = "$last" ] || continue
       out="$WORK/$EVAL_NAME/step_$((10#$(basename "$checkpoint")))"
       [ -f "$out/results.json" ] && continue
       mkdir -p "$(dirname "$out")"

@@ -23,7 +23,7 @@ for step in 001500 003000; do mkdir -p "$out/checkpoints/$step"; ln -sfn $step "
 
 def _run(tmp_path, mode, **settings) -> list[str]:
     stubs = tmp_path / "bin"
-    stubs.mkdir()
+    stubs.mkdir(parents=True)
     for name, body in (("tavis", TAVIS), ("lerobot-train", LEROBOT_TRAIN)):
         (stubs / name).write_text("#!/usr/bin/env bash\n" + body)
         (stubs / name).chmod(0o755)
@@ -53,3 +53,12 @@ def test_eval_options_reach_tavis_eval_and_its_folder_is_eval_name(tmp_path):
     assert len(evals) == 2
     assert all(call.endswith("--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1 "
                              f"--out {tmp_path}/work/eval_te/step_{step}") for call, step in zip(evals, (1500, 3000)))
+
+
+def test_checkpoints_last_evaluates_only_the_last_checkpoint_and_bad_values_are_refused(tmp_path):
+    _run(tmp_path, "train")
+    calls = _run(tmp_path / "again", "eval", WORK=str(tmp_path / "work"), CHECKPOINTS="last", EVAL_NAME="eval_te")
+    assert [call.split(" | ")[0].split(" --out ")[1] for call in calls] == [f"{tmp_path}/work/eval_te/step_3000"]
+    refused = subprocess.run(["bash", str(SCRIPT), "eval"], env={**os.environ, "CHECKPOINTS": "first"},
+                             capture_output=True, text=True)
+    assert refused.returncode == 2 and "CHECKPOINTS must be all or last, got 'first'" in refused.stderr
