@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from lerobot_tavis.envs.env import TavisEnv
+from lerobot_tavis.envs.reach import MOVED_M, REACHED_M
 from lerobot_tavis.envs.tasks.multi_shelf_scan import SUCCESS_X
 from lerobot_tavis.eval.episode_log import EpisodeLogger
 from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
@@ -76,6 +77,12 @@ def test_evaluate_decides_as_before_over_a_demonstration_and_the_log_keeps_its_c
         assert flags and info["is_success"] == all(flags), info["conditions"]
     (record,) = [json.loads(line) for line in log.read_text().splitlines()]
     assert record["success"] == result.success and record["conditions"] == env.steps[-1][1]["conditions"]
+    reach = [info["reach"] for _, info in env.steps]
+    assert record["reach"] == reach[-1]
+    assert all(b["closest_hand_m"] <= a["closest_hand_m"] and b["target_moved_m"] >= a["target_moved_m"]
+               for a, b in zip(reach, reach[1:]))  # over the episode so far
+    if result.success:  # a demonstrator's success brought a hand to the target and moved it
+        assert reach[-1]["closest_hand_m"] <= REACHED_M and reach[-1]["target_moved_m"] >= MOVED_M, reach[-1]
 
 
 @pytest.mark.parametrize("task", ["conditional_pick", "clutter_pick_lift"])

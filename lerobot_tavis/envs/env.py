@@ -20,9 +20,10 @@ from lerobot_tavis.envs.control import Controller
 from lerobot_tavis.envs.modes import (CAMERA_NAMES, DEFAULT_CAMERA_MODE, OVERVIEW_CAMERA, VIEW_CAMERAS, mode_cameras,
                                       neck_locked, resolve_camera_mode)
 from lerobot_tavis.envs.placement import body_speed
+from lerobot_tavis.envs.reach import ReachTracker
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
-from lerobot_tavis.envs.tasks.base import EpisodeFacts
+from lerobot_tavis.envs.tasks.base import EpisodeFacts, TargetFacts
 from lerobot_tavis.envs.tasks.catalog import VISUAL_SPLIT, parse_split, task_info
 from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.world import World, build_world
@@ -76,7 +77,9 @@ class TavisEnv(gym.Env):
     An episode ends early, truncated and unsuccessful, if MuJoCo reports an instability (it then resets the
     simulation state itself); `info["instability"]` names the warning and when it fired. Otherwise every step's
     `info["conditions"]` holds the parts of the task's success rule (`Task.evaluate` less "success", which is
-    `info["is_success"]`), e.g. `{"target_lifted": True, "target_slow": False, "target_height_m": 1.31, ...}`.
+    `info["is_success"]`), e.g. `{"target_lifted": True, "target_slow": False, "target_height_m": 1.31, ...}`, and
+    `info["reach"]` how far the episode has got toward a task's target so far (`lerobot_tavis.envs.reach`):
+    `{"closest_hand_m": 0.012, "target_moved_m": 0.25}`, or None for a task without one.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": physics.POLICY_HZ}
@@ -117,6 +120,7 @@ class TavisEnv(gym.Env):
         self._robot = make_robot(robot)
         self._sim: _Sim | None = None
         self._facts: EpisodeFacts | None = None
+        self._reach: ReachTracker | None = None  # tasks with a target: how near the hands got, how far it moved
         self._steps = 0
         self._last_frames: dict[str, np.ndarray] | None = None
         self._success_s: float | None = None  # when the task first reported success in this episode
@@ -150,6 +154,7 @@ class TavisEnv(gym.Env):
         self._success_s = None
         if self.split == "ood_init_pose":
             self._warm_up(sim)
+        self._reach = self._track_reach(sim)
         return self._observe(sim), {"is_success": False}
 
     def step(self, action):
@@ -164,13 +169,16 @@ class TavisEnv(gym.Env):
                     "instability": f"{unstable} at step {self._steps} ({self._steps / self.fps:.2f} s)"}
             return self._observe(sim), 0.0, False, True, info
         self._task.after_step(sim.model, sim.data, self._steps / self.fps)
+        if self._reach is not None:
+            self._reach.update(sim.data)
         evaluation = self._task.evaluate(sim.data)
         success = bool(evaluation["success"])
         if success and self._success_s is None:
             self._success_s = self._steps / self.fps
         truncated = self._steps >= self._max_episode_steps and not success
         conditions = {name: value for name, value in evaluation.items() if name != "success"}
-        info = {"is_success": success, "applied_action": applied, "conditions": conditions}
+        info = {"is_success": success, "applied_action": applied, "conditions": conditions,
+                "reach": None if self._reach is None else self._reach.summary()}
         return self._observe(sim), float(success), success, truncated, info
 
     def render(self) -> np.ndarray:
@@ -258,6 +266,12 @@ class TavisEnv(gym.Env):
                 sim.advance_tick()
             self._steps += 1
             self._task.after_step(sim.model, sim.data, self._steps / self.fps)
+
+    def _track_reach(self, sim: _Sim) -> ReachTracker | None:
+        if not isinstance(self._facts, TargetFacts):
+            return None
+        sites = tuple(arm.grasp_site for arm in sim.world.arms.values())
+        return ReachTracker(sim.data, sim.model.body(self._facts.target).id, sites)
 
     def _observe(self, sim: _Sim) -> dict:
         self._last_frames = sim.rig.render(sim.data)

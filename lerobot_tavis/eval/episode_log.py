@@ -7,7 +7,9 @@ episode ends, writes the fields of every metric of `lerobot_tavis.metrics.regist
 them at the env's rate (20 Hz in evaluation): GALT for successful episodes of head-camera modes, as the reference
 does, and the wrist lead of the final grasp for successful TAVIS-Hands episodes. The metric fields are also added
 to that step's `info`. Before them, `conditions` holds the final step's `info["conditions"]`: the parts of the
-task's success rule (`Task.evaluate`), or null when the env gave none (an episode ended by an instability).
+task's success rule (`Task.evaluate`), and `reach` its `info["reach"]`: how near a hand came to the task's target
+and how far the target moved over the episode (`lerobot_tavis.envs.reach`); each is null when the env gave none
+(an episode ended by an instability; `reach` also for a task without a target).
 """
 
 from __future__ import annotations
@@ -49,8 +51,8 @@ class EpisodeLogger(gym.Wrapper):
         if terminated or truncated:
             success = bool(info["is_success"])
             metrics = self._metrics(success)
-            conditions = {"conditions": info.get("conditions")}
-            self._append(self._record(success) | conditions | metrics | {"instability": info.get("instability")})
+            outcome = {"conditions": info.get("conditions"), "reach": info.get("reach")}
+            self._append(self._record(success) | outcome | metrics | {"instability": info.get("instability")})
             info = {**info, **metrics}
         return obs, reward, terminated, truncated, info
 

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_tavis.atomic import atomic_path, write_text
+from lerobot_tavis.envs.reach import FAILURE_STAGES, MOVED_M, REACHED_M, failure_stage
 from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
@@ -63,6 +64,7 @@ class Cell:
     successes: list[bool] = field(default_factory=list)
     metrics: dict[str, LeadTimes] = field(default_factory=lambda: {m.name: LeadTimes() for m in episode_metrics()})
     unstable: int = 0  # episodes ended by a simulator instability (counted as failures)
+    failure_stages: dict[str, int] = field(default_factory=dict)  # failed episodes with a `reach`, by stage
 
     def add(self, record: dict) -> None:
         """One scored episode record of the episode log."""
@@ -70,6 +72,9 @@ class Cell:
         for metric in episode_metrics():
             self.metrics[metric.name].add(record.get(metric.value_field), record.get(metric.reason_field))
         self.unstable += bool(record.get("instability"))
+        if not record["success"] and record.get("reach"):
+            stage = failure_stage(record["reach"])
+            self.failure_stages[stage] = self.failure_stages.get(stage, 0) + 1
 
     def summary(self) -> dict:
         k, n = sum(self.successes), len(self.successes)
@@ -77,6 +82,8 @@ class Cell:
         return {
             "task": self.task, "suite": self.suite, "split": self.split, "n": n, "successes": k,
             "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high, "unstable": self.unstable,
+            "failure_stages": {stage: self.failure_stages.get(stage, 0) for stage in FAILURE_STAGES}
+            if self.failure_stages else {},
             **{key: value for name, times in self.metrics.items() for key, value in times.summary(name).items()},
         }
 
@@ -223,6 +230,7 @@ def markdown(report: dict) -> str:
     lines += ["| **AVERAGE** (pooled) | " + " | ".join(avg + [""] * len(deltas)) + " |"]
     for metric in episode_metrics():
         lines += _lead_table(cells, tasks, splits, metric.name, metric.caption)
+    lines += _failure_table(cells, tasks, splits)
     unstable = [f"{c['task']} {c['split']}: {c['unstable']} of {c['n']}" for c in report["cells"] if c["unstable"]]
     if unstable:
         lines += ["", "Episodes ended by a simulator instability (counted as failures; the episode log names the "
@@ -244,6 +252,23 @@ def _lead_table(cells: dict, tasks: list[str], splits: list[str], prefix: str, c
     if not rows:
         return []
     return ["", caption, "", "| task | split | median | IQR | n valid | reasons |", "|---|---|---|---|---|---|", *rows]
+
+
+def _failure_table(cells: dict, tasks: list[str], splits: list[str]) -> list[str]:
+    """Failed episodes per task x split by how far they got toward the target (episodes logged with `reach`)."""
+    rows = []
+    for task, split in ((t, s) for t in tasks for s in splits):
+        stages = (cells.get((task, split)) or {}).get("failure_stages")
+        if stages:
+            counts = " | ".join(str(stages[stage]) for stage in FAILURE_STAGES)
+            rows.append(f"| {task} | {split} | {sum(stages.values())} | {counts} |")
+    if not rows:
+        return []
+    caption = (f"Failed episodes by how far they got: no hand within {100 * REACHED_M:.0f} cm of the target's "
+               f"centre; a hand there but the target moved less than {100 * MOVED_M:.0f} cm; the target moved, "
+               "no success.")
+    return ["", caption, "", "| task | split | failed | not reached | reached, not moved | moved, no success |",
+            "|---|---|---|---|---|---|", *rows]
 
 
 def _seconds(value: float | None) -> str:

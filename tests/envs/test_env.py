@@ -9,6 +9,7 @@ from gymnasium.utils.env_checker import check_env
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_MODES
+from lerobot_tavis.envs.reach import MOVED_M, REACHED_M, failure_stage
 from lerobot_tavis.overlay import Caption, compose
 from tests.conftest import run_steps
 
@@ -175,3 +176,14 @@ def test_the_overview_camera_is_for_people_only(small_env):
     assert overview.shape == head.shape and overview.std() > 10 and not np.array_equal(overview, head)
     with pytest.raises(ValueError, match="overview"):
         small_env(cameras=("topdown",))
+
+
+def test_reach_tells_a_hand_that_never_got_to_the_target(small_env):
+    env = small_env(task="conditional_pick")
+    env.reset(seed=1000)
+    *_, info = env.step(canonical.rest_action())
+    reach = info["reach"]
+    assert reach["closest_hand_m"] > REACHED_M and reach["target_moved_m"] < MOVED_M
+    assert failure_stage(reach) == "not_reached"
+    assert failure_stage({"closest_hand_m": 0.01, "target_moved_m": 0.0}) == "reached_not_moved"
+    assert failure_stage({"closest_hand_m": 0.01, "target_moved_m": 0.1}) == "moved_no_success"

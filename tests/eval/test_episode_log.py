@@ -38,7 +38,8 @@ class ScriptedEnv(gym.Env):
         success = done and self.success
         return np.zeros(1, np.float32), float(success), success, done and not success, {
             "is_success": success, "applied_action": applied,
-            "conditions": {"target_lifted": done, "target_slow": success, "target_height_m": 1.0 + 0.01 * self.t}}
+            "conditions": {"target_lifted": done, "target_slow": success, "target_height_m": 1.0 + 0.01 * self.t},
+            "reach": {"closest_hand_m": 0.3 / self.t, "target_moved_m": 0.01 * self.t}}
 
 
 def _run(env, seed, steps):
@@ -60,6 +61,7 @@ def test_a_successful_episode_is_logged_once_with_its_galt(tmp_path):
     assert record["suite"] == "tavis_head" and record["task_id"] == 3 and record["task"] == "clutter_pick_lift"
     assert record["conditions"] == {"target_lifted": True, "target_slow": True,
                                     "target_height_m": 1.0 + 0.01 * len(actions)}  # the final step's
+    assert record["reach"] == {"closest_hand_m": 0.3 / len(actions), "target_moved_m": 0.01 * len(actions)}
     assert record["galt_reason"] == "ok" and abs(record["galt_s"] - 1.0) < 0.1 and record["galt_arm"] == "right"
     assert info["galt_s"] == record["galt_s"]
 
@@ -92,5 +94,6 @@ def test_the_log_writes_the_fields_of_every_metric_in_registry_order(tmp_path):
     info = _run(EpisodeLogger(ScriptedEnv(actions), log, "tavis_head", 0), 0, len(actions))
     (record,) = [json.loads(line) for line in log.read_text().splitlines()]
     assert list(record) == ["robot", "suite", "task", "task_id", "split", "camera_mode", "seed", "success",
-                            "length_steps", "prompt", "conditions", *GALT.fields, *WRIST_LEAD.fields, "instability"]
+                            "length_steps", "prompt", "conditions", "reach", *GALT.fields, *WRIST_LEAD.fields,
+                            "instability"]
     assert all(info[field] == record[field] for field in GALT.fields + WRIST_LEAD.fields)

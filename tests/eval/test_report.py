@@ -73,6 +73,28 @@ def test_report_summarises_the_wrist_lead_of_hands_tasks(tmp_path):
     assert "| peeking_box | id | 2.00 | 1.50 - 2.50 | 3 | no_fixation 1, ok 3 |" in markdown(build_report(tmp_path))
 
 
+def test_report_counts_failed_episodes_by_how_far_they_got(tmp_path):
+    path = tmp_path / "run"
+    path.mkdir()
+    reaches = [(0.20, 0.0), (0.30, 0.01), (0.01, 0.005), (0.02, 0.30), (0.01, 0.40), None]  # the last: logged before
+    successes = [False, False, False, False, True, False]
+    records = [{**_record("conditional_pick", 0, 1000 + ix, success),
+                "reach": reach and {"closest_hand_m": reach[0], "target_moved_m": reach[1]}}
+               for ix, (reach, success) in enumerate(zip(reaches, successes))]
+    (path / "eval_info.json").write_text(json.dumps(
+        {"per_task": [{"task_group": "tavis_head", "task_id": 0, "metrics": {"successes": successes}}]}))
+    (path / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    (cell,) = build_report(tmp_path)["cells"]
+    assert cell["failure_stages"] == {"not_reached": 2, "reached_not_moved": 1, "moved_no_success": 1}
+    assert "| conditional_pick | id | 4 | 2 | 1 | 1 |" in markdown(build_report(tmp_path))
+
+
+def test_no_failure_table_without_reach_records(tmp_path):
+    _eval_dir(tmp_path / "id", "id", {"conditional_pick": [True, False]})
+    (cell,) = build_report(tmp_path)["cells"]
+    assert cell["failure_stages"] == {} and "how far they got" not in markdown(build_report(tmp_path))
+
+
 def test_missing_or_corrupt_logs_give_clear_errors(tmp_path):
     _eval_dir(tmp_path / "a", "id", {"conditional_pick": [True]})
     (tmp_path / "a" / "episodes.jsonl").write_text('{"suite": "tavis_head"\n')
