@@ -4,7 +4,8 @@ Every `eval_info.json` under the directory (LeRobot's result of one lerobot-eval
 `episodes.jsonl` next to it: per (suite, task_id), a log record belongs to episode `seed - start_seed` (the start
 seed is the smallest logged seed) and only episodes below LeRobot's `n_episodes` count, exactly the episodes
 LeRobot scored. Every metric of `lerobot_tavis.metrics.registry` (GALT, the wrist lead) is summarised per cell from
-its `<name>_s` and `<name>_reason` fields, in registry order. Writes `results.json`, `results.md`,
+its `<name>_s` and `<name>_reason` fields, in registry order, and the failed episodes logged with `reach` are
+counted by how far they got (`lerobot_tavis.envs.reach.failure_stage`). Writes `results.json`, `results.md`,
 `success_rates.png` and `<metric>_<task>.png` (metrics with a histogram, e.g. `galt_<task>.png`) into the directory,
 and beside each evaluation's videos a copy with the episode's GALT events drawn on (`videos_annotated/`).
 """
