@@ -171,7 +171,8 @@ def build_parser() -> argparse.ArgumentParser:
         ("presets", PresetsOptions, _presets, "list the training presets, or print the path of one"),
         ("train", TrainOptions, _train,
          "lerobot-train with a preset (checks pi0 downloads first); extra arguments go to lerobot-train"),
-        ("report", ReportOptions, _report, "success rates with Wilson CIs, GALT, plots from eval outputs"),
+        ("report", ReportOptions, _report,
+         "success rates with Wilson CIs, GALT, failure stages, plots from eval outputs"),
     ):
         commands.add_parser(name, help=help, options=options).set_defaults(run=run)
     return parser
