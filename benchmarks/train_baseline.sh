@@ -99,7 +99,8 @@ case "${1:-}" in
     index=0
     for condition in head_wrist fixed_wrist; do
       ( if (( ${#gpus[@]} > 1 )); then  # MuJoCo's EGL follows CUDA_VISIBLE_DEVICES only where the driver maps them
-          export CUDA_VISIBLE_DEVICES=${gpus[index % ${#gpus[@]}]} MUJOCO_EGL_DEVICE_ID=${gpus[index % ${#gpus[@]}]}
+          gpu=${gpus[index % ${#gpus[@]}]}
+          export CUDA_VISIBLE_DEVICES=$gpu MUJOCO_EGL_DEVICE_ID=$gpu
         fi
         CONDITION=$condition WORKERS=$(( WORKERS > 1 ? WORKERS / 2 : 1 )) "$0" cell > "$WORK/cell_$condition.log" 2>&1
       ) &

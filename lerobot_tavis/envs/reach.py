@@ -9,7 +9,7 @@ import numpy as np
 
 from lerobot_tavis.envs.tasks.base import MEASURE_DECIMALS
 
-REACHED_M = 0.05  # a hand's grasp site this near the target's origin got to it (the demonstrators' holding test)
+REACHED_M = 0.05  # a hand's grasp site this near the target's origin got to it (the demonstrators' test too)
 MOVED_M = 0.02  # the target's origin this far from where the episode found it was moved by the robot
 FAILURE_STAGES = ("not_reached", "reached_not_moved", "moved_no_success")
 

@@ -13,6 +13,7 @@ and beside each evaluation's videos a copy with the episode's GALT events drawn 
 from __future__ import annotations
 
 import json
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -65,7 +66,7 @@ class Cell:
     successes: list[bool] = field(default_factory=list)
     metrics: dict[str, LeadTimes] = field(default_factory=lambda: {m.name: LeadTimes() for m in episode_metrics()})
     unstable: int = 0  # episodes ended by a simulator instability (counted as failures)
-    failure_stages: dict[str, int] = field(default_factory=dict)  # failed episodes with a `reach`, by stage
+    failure_stages: Counter = field(default_factory=Counter)  # failed episodes with a `reach`, by stage
 
     def add(self, record: dict) -> None:
         """One scored episode record of the episode log."""
@@ -74,8 +75,7 @@ class Cell:
             self.metrics[metric.name].add(record.get(metric.value_field), record.get(metric.reason_field))
         self.unstable += bool(record.get("instability"))
         if not record["success"] and record.get("reach"):
-            stage = failure_stage(record["reach"])
-            self.failure_stages[stage] = self.failure_stages.get(stage, 0) + 1
+            self.failure_stages[failure_stage(record["reach"])] += 1
 
     def summary(self) -> dict:
         k, n = sum(self.successes), len(self.successes)
@@ -83,8 +83,8 @@ class Cell:
         return {
             "task": self.task, "suite": self.suite, "split": self.split, "n": n, "successes": k,
             "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high, "unstable": self.unstable,
-            "failure_stages": {stage: self.failure_stages.get(stage, 0) for stage in FAILURE_STAGES}
-            if self.failure_stages else {},
+            "failure_stages": {stage: self.failure_stages[stage] for stage in FAILURE_STAGES} if self.failure_stages
+            else {},
             **{key: value for name, times in self.metrics.items() for key, value in times.summary(name).items()},
         }
 

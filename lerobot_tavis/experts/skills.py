@@ -15,6 +15,7 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.control import ArmIK
 from lerobot_tavis.envs.objects import PROPS
+from lerobot_tavis.envs.reach import REACHED_M
 from lerobot_tavis.experts.base import Expert, Hold, Move, Segment, play
 from lerobot_tavis.experts.gaze import GazeSolver
 from lerobot_tavis.experts.grasping import Grasp, carry_options, grasp_candidates
@@ -203,5 +204,5 @@ class SkilledExpert(Expert):
         """Whether prop `name` is between the (not fully closed) fingers of `side`'s hand in `data`."""
         arm = self.env.world.arms[side]
         opening = data.qpos[arm.finger_qpos[0]]
-        near = np.linalg.norm(data.site_xpos[arm.grasp_site] - data.xpos[self.env.model.body(name).id]) < 0.05
+        near = np.linalg.norm(data.site_xpos[arm.grasp_site] - data.xpos[self.env.model.body(name).id]) < REACHED_M
         return bool(opening > 0.004 and near)
