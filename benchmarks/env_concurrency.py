@@ -122,7 +122,8 @@ def main() -> None:
     counts = [(n, True) for n in args.render] + [(n, False) for n in args.no_render]
     if policy:
         counts.insert(0, (0, False))  # the policy alone
-    print(f"{args.camera_mode} at {args.image_size}, {os.cpu_count()} CPUs, MUJOCO_GL={os.environ['MUJOCO_GL']}"
+    cpus = len(os.sched_getaffinity(0))  # those this process may use (taskset, a container's cpuset)
+    print(f"{args.camera_mode} at {args.image_size}, {cpus} CPUs, MUJOCO_GL={os.environ['MUJOCO_GL']}"
           + (f", policy chunks for {args.policy_batch} envs, DDIM-{args.denoising_steps}" if policy else ""))
     print("\n| processes | cameras rendered | env steps/s (all processes) | CPU cores busy | policy chunk (ms) |"
           "\n|---|---|---|---|---|")

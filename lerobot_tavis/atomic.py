@@ -28,3 +28,9 @@ def write_text(path: str | Path, text: str) -> Path:
     with atomic_path(path) as partial:
         partial.write_text(text)
     return Path(path)
+
+
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    with atomic_path(path) as partial:
+        partial.write_bytes(data)
+    return Path(path)

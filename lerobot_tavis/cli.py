@@ -53,6 +53,7 @@ class TrainOptions:
 class ReportOptions:
     eval_dir: Path = option(help="directory holding lerobot-eval outputs (eval_info.json, episodes.jsonl)",
                             positional=True)
+    workers: int | None = option(None, "processes annotating the videos (default: every core this process may use)")
 
 
 def _printing(target: str):
@@ -70,7 +71,7 @@ def _printing(target: str):
 def _report(options: ReportOptions) -> None:
     from lerobot_tavis.eval.report import write_report
 
-    for path in write_report(options.eval_dir):
+    for path in write_report(options.eval_dir, options.workers):
         print(path)
 
 

@@ -2,38 +2,52 @@
 
 from __future__ import annotations
 
+import io
+import itertools
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from lerobot_tavis.atomic import atomic_path
+from lerobot_tavis.atomic import atomic_path, write_bytes
 
 
-def write_mp4(path: str | Path, frames: list[np.ndarray], fps: int) -> Path:
-    """Encode RGB uint8 frames (H, W, 3; H and W even) as H.264 MP4."""
+def encode_mp4(frames: Iterable[np.ndarray], fps: int) -> bytes:
+    """H.264 MP4 of RGB uint8 frames (H, W, 3; H and W even), encoded as they come: an iterator of frames is never
+    held whole."""
     import av  # PyAV: only where videos are written
 
-    path = Path(path)
-    if not frames:
-        raise ValueError(f"no frames to write to {path}")
-    height, width = frames[0].shape[:2]
-    with atomic_path(path) as partial, av.open(str(partial), mode="w", format="mp4") as container:
+    frames = iter(frames)
+    first = next(frames, None)
+    if first is None:
+        raise ValueError("no frames to encode")
+    height, width = first.shape[:2]
+    buffer = io.BytesIO()
+    with av.open(buffer, mode="w", format="mp4") as container:
         stream = container.add_stream("libx264", rate=fps)
         stream.width, stream.height, stream.pix_fmt = width, height, "yuv420p"
         stream.options = {"crf": "20", "preset": "veryfast"}
-        for frame in frames:
+        for frame in itertools.chain([first], frames):
             container.mux(stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(frame), format="rgb24")))
         container.mux(stream.encode())
-    return path
+    return buffer.getvalue()
 
 
-def read_mp4(path: str | Path) -> list[np.ndarray]:
-    """The RGB uint8 frames (H, W, 3) of a video file."""
+def write_mp4(path: str | Path, frames: list[np.ndarray], fps: int) -> Path:
+    """Write RGB uint8 frames (H, W, 3; H and W even) as an H.264 MP4 file (`encode_mp4`)."""
+    if not frames:
+        raise ValueError(f"no frames to write to {path}")
+    return write_bytes(path, encode_mp4(frames, fps))
+
+
+def iter_mp4(path: str | Path) -> Iterator[np.ndarray]:
+    """The RGB uint8 frames (H, W, 3) of a video file, decoded one at a time."""
     import av  # PyAV: only where videos are read
 
     with av.open(str(path)) as container:
-        return [frame.to_ndarray(format="rgb24") for frame in container.decode(video=0)]
+        for frame in container.decode(video=0):
+            yield frame.to_ndarray(format="rgb24")
 
 
 def write_png(path: str | Path, rgb: np.ndarray) -> Path:

@@ -13,6 +13,7 @@ and beside each evaluation's videos a copy with the episode's GALT events drawn 
 from __future__ import annotations
 
 import json
+import os
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -326,9 +327,10 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
-def write_report(root: str | Path) -> list[Path]:
+def write_report(root: str | Path, workers: int | None = None) -> list[Path]:
     """Build the report of every evaluation under `root` and write it there, with an annotated copy of each
-    episode video (`lerobot_tavis.eval.annotate`); returns the written files."""
+    episode video (`lerobot_tavis.eval.annotate`, `workers` processes: default every core this process may use);
+    returns the written files."""
     from lerobot_tavis.eval.annotate import annotate_videos
 
     root = Path(root)
@@ -336,8 +338,4 @@ def write_report(root: str | Path) -> list[Path]:
     written = plot(report, root)
     written.append(write_text(root / "results.json", json.dumps(report, indent=2) + "\n"))
     written.append(write_text(root / "results.md", markdown(report)))
-    for eval_dir in eval_dirs(root):
-        written += annotate_videos(eval_dir)
-    return written
-
-
+    return written + annotate_videos(eval_dirs(root), len(os.sched_getaffinity(0)) if workers is None else workers)

@@ -5,7 +5,7 @@ import json
 import numpy as np
 
 from lerobot_tavis.eval.report import write_report
-from lerobot_tavis.media import read_mp4, write_mp4
+from lerobot_tavis.media import iter_mp4, write_mp4
 from lerobot_tavis.overlay import EVENT_COLOURS, Caption, band_height, compose
 
 FPS = 20
@@ -30,20 +30,25 @@ def _has(region, colour):
     return bool(np.any(np.all(np.abs(region.astype(int) - colour) < 40, axis=-1)))
 
 
-def test_videos_get_a_copy_with_the_episode_events(tmp_path):
+def _filmed_evaluation(eval_dir):
+    """An evaluation folder as lerobot-eval leaves it: a success (seed 1000) and a failure, both filmed."""
     records = [_record(1000, True, 40, gaze=0.5), _record(1001, False, 60)]
-    (tmp_path / "eval_info.json").write_text(json.dumps({"per_task": [
+    (eval_dir / "eval_info.json").write_text(json.dumps({"per_task": [
         {"task_group": "tavis_head", "task_id": 0, "metrics": {"successes": [True, False]}}]}))
-    (tmp_path / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    (eval_dir / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
     for ix, record in enumerate(records):
-        _live_video(tmp_path / "videos" / "tavis_head_0" / f"eval_episode_{ix}.mp4", record["length_steps"] + 1)
+        _live_video(eval_dir / "videos" / "tavis_head_0" / f"eval_episode_{ix}.mp4", record["length_steps"] + 1)
 
-    written = write_report(tmp_path)
+
+def test_videos_get_a_copy_with_the_episode_events(tmp_path):
+    _filmed_evaluation(tmp_path)
+
+    written = write_report(tmp_path, workers=1)
 
     annotated = [tmp_path / "videos_annotated" / "tavis_head_0" / f"eval_episode_{ix}.mp4" for ix in (0, 1)]
     assert all(path in written for path in annotated)
-    success_frames, failure_frames = read_mp4(annotated[0]), read_mp4(annotated[1])
-    original = read_mp4(tmp_path / "videos" / "tavis_head_0" / "eval_episode_0.mp4")
+    success_frames, failure_frames = list(iter_mp4(annotated[0])), list(iter_mp4(annotated[1]))
+    original = list(iter_mp4(tmp_path / "videos" / "tavis_head_0" / "eval_episode_0.mp4"))
     assert len(success_frames) == 41 and len(failure_frames) == 61
     band = band_height(original[0].shape[1])
     assert np.abs(success_frames[5][:-band].astype(int) - original[5][:-band]).mean() < 2  # panel untouched
@@ -51,3 +56,17 @@ def test_videos_get_a_copy_with_the_episode_events(tmp_path):
         assert _has(success_frames[0][-band:], EVENT_COLOURS[colour]), colour
     assert not _has(original[0][-band:], EVENT_COLOURS["gaze"])
     assert not any(_has(failure_frames[-1][-band:], EVENT_COLOURS[name]) for name in EVENT_COLOURS)
+
+
+def test_annotated_videos_do_not_depend_on_the_number_of_workers(tmp_path):
+    """Same frames: x264's threads may code them into different bytes."""
+    frames = {}
+    for workers in (1, 2):
+        eval_dir = tmp_path / f"workers_{workers}"
+        eval_dir.mkdir()
+        _filmed_evaluation(eval_dir)
+        written = sorted(path for path in write_report(eval_dir, workers=workers) if path.suffix == ".mp4")
+        frames[workers] = [np.stack(list(iter_mp4(path))) for path in written]
+    assert [len(video) for video in frames[1]] == [41, 61]
+    assert all(np.array_equal(one, two) for one, two in zip(frames[1], frames[2], strict=True))
+    assert not list(tmp_path.rglob("*.partial*"))
