@@ -13,7 +13,8 @@ holding its measured pose. Prints one Markdown row per count: env steps per seco
 cores they kept busy. With MUJOCO_GL=egl the renders go to the GPU where there is one. With `--policy-batch B` the
 main process builds the `diffusion_head_wrist` preset's policy (random weights, DDIM, AMP on a GPU) and generates
 action chunks for B envs from random observations during the same window, alone first (0 processes): milliseconds
-per chunk, GPU time included.
+per chunk, GPU time included (the first chunk untimed; e.g. `--policy-arg=--policy.compile_model=true` times
+LeRobot's torch.compile of the denoising network).
 """
 
 from __future__ import annotations
@@ -70,20 +71,26 @@ def make_policy(batch: int, denoising_steps: int, policy_args: list[str]):
 
 
 def _chunk_ms(policy, observation, seconds: float) -> float:
-    """Milliseconds per generated action chunk, select_action called for `seconds` (GPU work waited for)."""
+    """Milliseconds per generated action chunk, select_action called for `seconds` (GPU work waited for) after one
+    untimed chunk (the first builds what is built lazily: cuDNN's plans, a compiled model's graphs)."""
     import torch
 
     cuda = observation["observation.state"].is_cuda
     autocast = torch.autocast("cuda") if cuda else contextlib.nullcontext()
+
+    def one_chunk() -> None:
+        for _ in range(policy.config.n_action_steps):  # the first call of each round generates the chunk
+            policy.select_action(observation)
+        if cuda:
+            torch.cuda.synchronize()
+
     policy.reset()
-    chunks, start = 0, time.perf_counter()
     with torch.inference_mode(), autocast:
+        one_chunk()
+        chunks, start = 0, time.perf_counter()
         while time.perf_counter() - start < seconds:
-            for _ in range(policy.config.n_action_steps):  # the first call of each round generates the chunk
-                policy.select_action(observation)
+            one_chunk()
             chunks += 1
-            if cuda:
-                torch.cuda.synchronize()
     return 1000 * (time.perf_counter() - start) / chunks
 
 
