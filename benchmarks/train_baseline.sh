@@ -7,7 +7,7 @@
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
 # demonstrations, as many as the reference's datasets hold per task), STEPS, SAVE_FREQ and BATCH (the preset's, 6000,
-# 2000 and 64), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), EVAL_JOBS
+# 2000 and 64), SEED (lerobot-train's, 1000 as its default: another seed trains a replicate), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), EVAL_JOBS
 # and EVAL_BATCH (4 and 12: an evaluation's jobs sharing the GPU, each playing EVAL_EPISODES / EVAL_JOBS episodes
 # in batches of EVAL_BATCH envs), FILM (episodes filmed per evaluation: 2, as each filmed sub-env also renders the
 # overview), EVAL_OPTIONS (more `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01
@@ -43,6 +43,7 @@ EVAL_JOBS=${EVAL_JOBS:-4}
 EVAL_BATCH=${EVAL_BATCH:-12}
 FILM=${FILM:-2}
 EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
+SEED=${SEED:-1000}
 CHECKPOINTS=${CHECKPOINTS:-all}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 WORK=${WORK:-/tmp/tavis_baseline}
@@ -80,7 +81,7 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]
   lerobot-train --config_path="$(tavis presets "act_${CONDITION}_compact")" \
     --dataset.repo_id="local/$(basename "$dataset")" --dataset.root="$dataset" --dataset.video_backend="$BACKEND" \
     --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true --num_workers="$WORKERS" \
-    --log_freq=100 --output_dir="$out" "$@"
+    --seed="$SEED" --log_freq=100 --output_dir="$out" "$@"
 }
 
 evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the id split of TASK

@@ -62,3 +62,12 @@ def test_checkpoints_last_evaluates_only_the_last_checkpoint_and_bad_values_are_
     refused = subprocess.run(["bash", str(SCRIPT), "eval"], env={**os.environ, "CHECKPOINTS": "first"},
                              capture_output=True, text=True)
     assert refused.returncode == 2 and "CHECKPOINTS must be all or last, got 'first'" in refused.stderr
+
+
+def test_seed_reaches_lerobot_train_and_defaults_to_its_own(tmp_path):
+    def train_seeds(folder, **settings):
+        return [re.search(r"--seed=(\S+)", call)[1] for call in _run(folder, "train", **settings)
+                if call.startswith("lerobot-train")]
+
+    assert train_seeds(tmp_path / "default") == ["1000"]
+    assert train_seeds(tmp_path / "replicate", SEED="2000") == ["2000"]
