@@ -1,0 +1,96 @@
+"""How far off a hand may be and still grasp: each recorded demonstration replayed with the grasping arm's
+end-effector position commands shifted by a constant offset, and whether the task still succeeds.
+
+    python benchmarks/grasp_tolerance.py --raw RAW_DIR [--offsets-cm 0 0.5 1 1.5 2 3] [--episodes 8] [--workers 2]
+
+RAW_DIR is a `tavis record` directory (e.g. `tavis record --robot gr1t2 --tasks conditional_pick
+--episodes-per-task 8 --out RAW_DIR`). The grasping arm is the one whose commanded position travels farthest in
+the episode; its commanded position (canonical hip frame, so world axes up to the hip's yaw) is shifted for the
+whole episode by `offset` along +x (away from the robot), -x, +y (to its left), -y, +z (up) and -z, the other
+commands replayed as recorded, then the last command held for `--hold-s` (a recording ends the moment the task
+succeeds, so a shifted lift may need a moment more). The demonstrators plan the grasp from the simulator state,
+so offset 0 must succeed; the offset at which success falls off is the precision a policy's hand needs. Prints a
+Markdown table: success per offset and direction over the episodes. Nothing is rendered.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+DIRECTIONS = {"+x": (1, 0, 0), "-x": (-1, 0, 0), "+y": (0, 1, 0), "-y": (0, -1, 0), "+z": (0, 0, 1), "-z": (0, 0, -1)}
+
+
+def grasping_arm(actions: np.ndarray):
+    """The canonical arm slots whose commanded position travels farthest over `actions` (T, 19)."""
+    from lerobot_tavis import canonical
+
+    def travel(arm) -> float:
+        return float(np.sum(np.linalg.norm(np.diff(actions[:, arm.position], axis=0), axis=1)))
+
+    return max(canonical.ARMS, key=travel)
+
+
+def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float) -> list[bool]:
+    """Success of the raw episode at `path` replayed once per shift (m, canonical frame) of the grasping arm, its
+    last command held `hold_s` seconds more."""
+    from lerobot_tavis.dataset_tools.raw import load_episode
+    from lerobot_tavis.envs.env import TavisEnv
+
+    episode = load_episode(path)
+    env = TavisEnv(episode.task, episode.robot, split=episode.split, fps=episode.fps, cameras=())
+    arm = grasping_arm(episode.actions)
+    results = []
+    for shift_m in shifts_m:
+        actions = np.concatenate([episode.actions, np.repeat(episode.actions[-1:], round(hold_s * episode.fps), 0)])
+        actions[:, arm.position] += shift_m
+        env.reset(seed=episode.seed)
+        success = False
+        for action in actions:
+            _, _, terminated, truncated, info = env.step(action)
+            success = success or bool(info["is_success"])
+            if terminated or truncated:
+                break
+        results.append(success)
+    env.close()
+    return results
+
+
+def main() -> None:
+    from lerobot_tavis.dataset_tools.raw import Manifest
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--raw", required=True, help="a `tavis record` directory")
+    parser.add_argument("--offsets-cm", type=float, nargs="+", default=[0, 0.5, 1, 1.5, 2, 3])
+    parser.add_argument("--episodes", type=int, default=8, help="the first kept episodes of the recording")
+    parser.add_argument("--hold-s", type=float, default=2.0, help="the last command held this long after the end")
+    parser.add_argument("--workers", type=int, default=os.cpu_count())
+    args = parser.parse_args()
+    manifest = Manifest.load(args.raw)
+    kept = [entry for entry in manifest.episodes if entry.file][: args.episodes]
+    if not kept:
+        raise SystemExit(f"{args.raw} holds no kept episode")
+    offsets_cm = [cm for cm in args.offsets_cm if cm > 0]
+    shifts_m = [np.zeros(3)] + [cm / 100 * np.asarray(unit, dtype=float)
+                                for cm in offsets_cm for unit in DIRECTIONS.values()]
+    with ProcessPoolExecutor(args.workers) as pool:
+        outcomes = list(pool.map(replay_shifted, [os.path.join(args.raw, e.file) for e in kept],
+                                 [shifts_m] * len(kept), [args.hold_s] * len(kept)))
+    successes = np.array(outcomes).sum(axis=0)  # per shift, over the episodes
+    tasks = sorted({entry.task for entry in kept})
+    print(f"{len(kept)} demonstrations of {', '.join(tasks)} ({manifest.robot}, {manifest.split}), "
+          "grasping arm's commanded position shifted\n")
+    print("| offset (cm) | " + " | ".join(DIRECTIONS) + " |\n|---|" + "---|" * len(DIRECTIONS))
+    print(f"| 0 | {successes[0]}/{len(kept)} (unshifted) |" + " |" * (len(DIRECTIONS) - 1))
+    for i, cm in enumerate(offsets_cm):
+        row = successes[1 + i * len(DIRECTIONS): 1 + (i + 1) * len(DIRECTIONS)]
+        print(f"| {cm:g} | " + " | ".join(f"{n}/{len(kept)}" for n in row) + " |")
+
+
+if __name__ == "__main__":
+    main()

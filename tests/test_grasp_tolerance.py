@@ -1,0 +1,35 @@
+"""benchmarks/grasp_tolerance.py: a demonstration replayed with its grasping arm shifted succeeds unshifted and
+after a moment's hold, and fails when the hand is sent far below the grasp."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+
+from lerobot_tavis import canonical
+from lerobot_tavis.dataset_tools.raw import Manifest, load_episode
+from lerobot_tavis.dataset_tools.record import RecordConfig, record
+
+SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "grasp_tolerance.py"
+
+
+def _probe():
+    spec = importlib.util.spec_from_file_location("grasp_tolerance", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_grasping_arm_is_found_and_only_a_shift_far_below_the_grasp_fails(tmp_path):
+    probe = _probe()
+    record(RecordConfig(out_dir=tmp_path / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
+           progress=False)
+    entry = next(e for e in Manifest.load(tmp_path / "raw").episodes if e.file)
+    path = str(tmp_path / "raw" / entry.file)
+    actions = load_episode(path).actions
+    arm = probe.grasping_arm(actions)
+    idle = next(a for a in canonical.ARMS if a is not arm)
+    assert np.ptp(actions[:, arm.position], axis=0).max() > np.ptp(actions[:, idle.position], axis=0).max()
+
+    unshifted, far_below = probe.replay_shifted(path, [np.zeros(3), np.array([0.0, 0.0, -0.08])], hold_s=1.0)
+    assert unshifted and not far_below
