@@ -1,12 +1,13 @@
 """How far off a hand may be and still grasp: each recorded demonstration replayed with the grasping arm's
 end-effector position commands shifted by a constant offset, and whether the task still succeeds.
 
-    python benchmarks/grasp_tolerance.py --raw RAW_DIR [--offsets-cm 0 0.5 1 1.5 2 3] [--episodes 8] [--workers 2]
+    python benchmarks/grasp_tolerance.py --raw RAW_DIR [--offsets-cm 0.25 0.5 1 1.5 2] [--episodes 8] [--hold-s 2]
+                                         [--workers N]
 
 RAW_DIR is a `tavis record` directory (e.g. `tavis record --robot gr1t2 --tasks conditional_pick
 --episodes-per-task 8 --out RAW_DIR`). The grasping arm is the one whose commanded position travels farthest in
-the episode; its commanded position (canonical hip frame, so world axes up to the hip's yaw) is shifted for the
-whole episode by `offset` along +x (away from the robot), -x, +y (to its left), -y, +z (up) and -z, the other
+the episode; its commanded position (canonical hip frame: x forward, y to the robot's left, z up) is shifted for
+the whole episode by `offset` along +x, -x, +y, -y, +z and -z, the other
 commands replayed as recorded, then the last command held for `--hold-s` (a recording ends the moment the task
 succeeds, so a shifted lift may need a moment more). The demonstrators plan the grasp from the simulator state,
 so offset 0 must succeed; the offset at which success falls off is the precision a policy's hand needs. Prints a
@@ -20,6 +21,7 @@ import os
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+from tqdm import tqdm
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -66,28 +68,31 @@ def main() -> None:
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--raw", required=True, help="a `tavis record` directory")
-    parser.add_argument("--offsets-cm", type=float, nargs="+", default=[0, 0.5, 1, 1.5, 2, 3])
+    parser.add_argument("--offsets-cm", type=float, nargs="+", default=[0.25, 0.5, 1, 1.5, 2],
+                        help="shifts besides none (cm, > 0)")
     parser.add_argument("--episodes", type=int, default=8, help="the first kept episodes of the recording")
     parser.add_argument("--hold-s", type=float, default=2.0, help="the last command held this long after the end")
     parser.add_argument("--workers", type=int, default=os.cpu_count())
     args = parser.parse_args()
+    if args.episodes < 1 or args.workers < 1 or args.hold_s < 0 or min(args.offsets_cm) <= 0:
+        parser.error("--episodes and --workers must be >= 1, --hold-s >= 0 and every offset > 0")
     manifest = Manifest.load(args.raw)
     kept = [entry for entry in manifest.episodes if entry.file][: args.episodes]
     if not kept:
         raise SystemExit(f"{args.raw} holds no kept episode")
-    offsets_cm = [cm for cm in args.offsets_cm if cm > 0]
     shifts_m = [np.zeros(3)] + [cm / 100 * np.asarray(unit, dtype=float)
-                                for cm in offsets_cm for unit in DIRECTIONS.values()]
+                                for cm in args.offsets_cm for unit in DIRECTIONS.values()]
     with ProcessPoolExecutor(args.workers) as pool:
-        outcomes = list(pool.map(replay_shifted, [os.path.join(args.raw, e.file) for e in kept],
-                                 [shifts_m] * len(kept), [args.hold_s] * len(kept)))
+        replays = pool.map(replay_shifted, [os.path.join(args.raw, e.file) for e in kept], [shifts_m] * len(kept),
+                           [args.hold_s] * len(kept))
+        outcomes = list(tqdm(replays, total=len(kept), desc="replays", unit="demonstration"))
     successes = np.array(outcomes).sum(axis=0)  # per shift, over the episodes
     tasks = sorted({entry.task for entry in kept})
     print(f"{len(kept)} demonstrations of {', '.join(tasks)} ({manifest.robot}, {manifest.split}), "
           "grasping arm's commanded position shifted\n")
     print("| offset (cm) | " + " | ".join(DIRECTIONS) + " |\n|---|" + "---|" * len(DIRECTIONS))
     print(f"| 0 | {successes[0]}/{len(kept)} (unshifted) |" + " |" * (len(DIRECTIONS) - 1))
-    for i, cm in enumerate(offsets_cm):
+    for i, cm in enumerate(args.offsets_cm):
         row = successes[1 + i * len(DIRECTIONS): 1 + (i + 1) * len(DIRECTIONS)]
         print(f"| {cm:g} | " + " | ".join(f"{n}/{len(kept)}" for n in row) + " |")
 

@@ -7,12 +7,13 @@
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
 # demonstrations, as many as the reference's datasets hold per task), STEPS, SAVE_FREQ and BATCH (the preset's, 6000,
-# 2000 and 64), SEED (lerobot-train's, 1000 as its default: another seed trains a replicate), WORKERS (recording, conversion and loading processes: all cores), EVAL_EPISODES (96), EVAL_JOBS
-# and EVAL_BATCH (4 and 12: an evaluation's jobs sharing the GPU, each playing EVAL_EPISODES / EVAL_JOBS episodes
-# in batches of EVAL_BATCH envs), FILM (episodes filmed per evaluation: 2, as each filmed sub-env also renders the
-# overview), EVAL_OPTIONS (more `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01
-# --policy-option n_action_steps=1" for ACT's temporal ensembling), EVAL_NAME (the evaluations' folder under
-# WORK: eval_<CONDITION>), CHECKPOINTS (which `eval` takes: all, or last), WORK (/tmp/tavis_baseline).
+# 2000 and 64), SEED (lerobot-train's, 1000 as its default: another seed trains a replicate), WORKERS (recording,
+# conversion and loading processes: all cores), EVAL_EPISODES (96), EVAL_JOBS and EVAL_BATCH (4 and 12: an
+# evaluation's jobs sharing the GPU, each playing EVAL_EPISODES / EVAL_JOBS episodes in batches of EVAL_BATCH envs),
+# FILM (episodes filmed per evaluation: 2, as each filmed sub-env also renders the overview), EVAL_OPTIONS (more
+# `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1" for
+# ACT's temporal ensembling), EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), CHECKPOINTS (which
+# `eval` takes: all, or last), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the

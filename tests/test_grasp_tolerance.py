@@ -20,7 +20,7 @@ def _probe():
     return module
 
 
-def test_the_grasping_arm_is_found_and_only_a_shift_far_below_the_grasp_fails(tmp_path):
+def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(tmp_path):
     probe = _probe()
     record(RecordConfig(out_dir=tmp_path / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
            progress=False)
