@@ -81,8 +81,9 @@ def test_evaluate_decides_as_before_over_a_demonstration_and_the_log_keeps_its_c
     assert record["reach"] == reach[-1]
     assert all(b["closest_hand_m"] <= a["closest_hand_m"] and b["target_moved_m"] >= a["target_moved_m"]
                for a, b in zip(reach, reach[1:]))  # over the episode so far
-    if result.success:  # a demonstrator's success brought a hand to the target and moved it
+    if result.success:  # a demonstrator's success brought a hand to the target, closed it there and moved it
         assert reach[-1]["closest_hand_m"] <= REACHED_M and reach[-1]["target_moved_m"] >= MOVED_M, reach[-1]
+        assert 0.0 <= reach[-1]["first_grasp_xy_m"] <= 0.02, reach[-1]  # pads centred on the object
 
 
 @pytest.mark.parametrize("task", ["conditional_pick", "clutter_pick_lift"])

@@ -170,7 +170,7 @@ class TavisEnv(gym.Env):
             return self._observe(sim), 0.0, False, True, info
         self._task.after_step(sim.model, sim.data, self._steps / self.fps)
         if self._reach is not None:
-            self._reach.update(sim.data)
+            self._reach.update(sim.data, applied)
         evaluation = self._task.evaluate(sim.data)
         success = bool(evaluation["success"])
         if success and self._success_s is None:
@@ -270,7 +270,7 @@ class TavisEnv(gym.Env):
     def _track_reach(self, sim: _Sim) -> ReachTracker | None:
         if not isinstance(self._facts, TargetFacts):
             return None
-        sites = tuple(arm.grasp_site for arm in sim.world.arms.values())
+        sites = {side: arm.grasp_site for side, arm in sim.world.arms.items()}
         return ReachTracker(sim.data, sim.model.body(self._facts.target).id, sites)
 
     def _observe(self, sim: _Sim) -> dict:

@@ -1,12 +1,14 @@
 """How far an episode got toward its target, to tell failures apart: a policy that never brought a hand to the
 target (searched in vain, or went for another object), one that reached it and never moved it (a missed or
-unclosed grasp), and one that moved it without succeeding (dropped, not lifted high enough)."""
+unclosed grasp), and one that moved it without succeeding (dropped, not lifted high enough); and how well placed
+its first grasp of the target was."""
 
 from __future__ import annotations
 
 import mujoco
 import numpy as np
 
+from lerobot_tavis import canonical
 from lerobot_tavis.envs.tasks.base import MEASURE_DECIMALS
 
 REACHED_M = 0.05  # a hand's grasp site this near the target's origin got to it (the demonstrators' test too)
@@ -15,26 +17,44 @@ FAILURE_STAGES = ("not_reached", "reached_not_moved", "moved_no_success")
 
 
 class ReachTracker:
-    """Over one episode of a task with a target body: the closest any hand's grasp site came to the target's origin
-    (m) and the farthest that origin got from where it was at the first observation (m), world frame."""
+    """Over one episode of a task with a target body, world frame: the closest any hand's grasp site came to the
+    target's origin (m), the farthest that origin got from where it was at the first observation (m), and the
+    horizontal distance (m) from the target's origin to the grasp site of the first hand that closed its gripper
+    within REACHED_M of it (None until one does; the demonstrators centre their pads on the object, so this is
+    how far off a grasp was placed)."""
 
-    def __init__(self, data: mujoco.MjData, target_body: int, grasp_sites: tuple[int, ...]):
+    def __init__(self, data: mujoco.MjData, target_body: int, grasp_sites: dict[str, int]):
         self._body, self._sites = target_body, grasp_sites
         self._start = data.xpos[target_body].copy()
+        self._closed = dict.fromkeys(grasp_sites, False)
         self.closest_hand_m, self.target_moved_m = np.inf, 0.0
-        self.update(data)
+        self.first_grasp_xy_m: float | None = None
+        self._measure(data)
 
-    def update(self, data: mujoco.MjData) -> None:
-        """Take the current state into account (after each env step)."""
+    def update(self, data: mujoco.MjData, command: np.ndarray) -> None:
+        """Take the state after an env step into account, and the canonical `command` that step applied."""
+        self._measure(data)
         target = data.xpos[self._body]
-        nearest = min(float(np.linalg.norm(data.site_xpos[site] - target)) for site in self._sites)
+        for arm in canonical.ARMS:
+            closed = command[arm.gripper] > 0.0
+            if closed and not self._closed[arm.side] and self.first_grasp_xy_m is None:
+                offset = data.site_xpos[self._sites[arm.side]] - target
+                if np.linalg.norm(offset) <= REACHED_M:
+                    self.first_grasp_xy_m = float(np.linalg.norm(offset[:2]))
+            self._closed[arm.side] = closed
+
+    def summary(self) -> dict[str, float | None]:
+        """`{"closest_hand_m", "target_moved_m", "first_grasp_xy_m"}`, to the millimetre as the success conditions
+        are."""
+        first = None if self.first_grasp_xy_m is None else round(self.first_grasp_xy_m, MEASURE_DECIMALS)
+        return {"closest_hand_m": round(self.closest_hand_m, MEASURE_DECIMALS),
+                "target_moved_m": round(self.target_moved_m, MEASURE_DECIMALS), "first_grasp_xy_m": first}
+
+    def _measure(self, data: mujoco.MjData) -> None:
+        target = data.xpos[self._body]
+        nearest = min(float(np.linalg.norm(data.site_xpos[site] - target)) for site in self._sites.values())
         self.closest_hand_m = min(self.closest_hand_m, nearest)
         self.target_moved_m = max(self.target_moved_m, float(np.linalg.norm(target - self._start)))
-
-    def summary(self) -> dict[str, float]:
-        """`{"closest_hand_m", "target_moved_m"}`, to the millimetre as the success conditions are."""
-        return {"closest_hand_m": round(self.closest_hand_m, MEASURE_DECIMALS),
-                "target_moved_m": round(self.target_moved_m, MEASURE_DECIMALS)}
 
 
 def failure_stage(reach: dict[str, float]) -> str:

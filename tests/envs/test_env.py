@@ -181,9 +181,13 @@ def test_the_overview_camera_is_for_people_only(small_env):
 def test_reach_tells_a_hand_that_never_got_to_the_target(small_env):
     env = small_env(task="conditional_pick")
     env.reset(seed=1000)
-    *_, info = env.step(canonical.rest_action())
+    closing = canonical.rest_action()
+    closing[[canonical.LEFT.gripper, canonical.RIGHT.gripper]] = canonical.GRIPPER_CLOSED
+    for action in (canonical.rest_action(), closing):  # grippers closed far from the target: no grasp of it
+        *_, info = env.step(action)
     reach = info["reach"]
     assert reach["closest_hand_m"] > REACHED_M and reach["target_moved_m"] < MOVED_M
+    assert reach["first_grasp_xy_m"] is None
     assert failure_stage(reach) == "not_reached"
     assert failure_stage({"closest_hand_m": 0.01, "target_moved_m": 0.0}) == "reached_not_moved"
     assert failure_stage({"closest_hand_m": 0.01, "target_moved_m": 0.1}) == "moved_no_success"
