@@ -68,6 +68,7 @@ class Cell:
     metrics: dict[str, LeadTimes] = field(default_factory=lambda: {m.name: LeadTimes() for m in episode_metrics()})
     unstable: int = 0  # episodes ended by a simulator instability (counted as failures)
     failure_stages: Counter = field(default_factory=Counter)  # failed episodes with a `reach`, by stage
+    first_grasps_xy_m: dict[bool, list[float]] = field(default_factory=lambda: {True: [], False: []})  # by success
 
     def add(self, record: dict) -> None:
         """One scored episode record of the episode log."""
@@ -75,8 +76,11 @@ class Cell:
         for metric in episode_metrics():
             self.metrics[metric.name].add(record.get(metric.value_field), record.get(metric.reason_field))
         self.unstable += bool(record.get("instability"))
-        if not record["success"] and record.get("reach"):
-            self.failure_stages[failure_stage(record["reach"])] += 1
+        reach = record.get("reach")
+        if reach and not record["success"]:
+            self.failure_stages[failure_stage(reach)] += 1
+        if reach and reach.get("first_grasp_xy_m") is not None:
+            self.first_grasps_xy_m[bool(record["success"])].append(reach["first_grasp_xy_m"])
 
     def summary(self) -> dict:
         k, n = sum(self.successes), len(self.successes)
@@ -86,6 +90,9 @@ class Cell:
             "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high, "unstable": self.unstable,
             "failure_stages": {stage: self.failure_stages[stage] for stage in FAILURE_STAGES} if self.failure_stages
             else {},
+            **{f"first_grasp_xy_median_m_{outcome}": float(np.median(values)) if values else None
+               for outcome, values in (("success", self.first_grasps_xy_m[True]),
+                                       ("failure", self.first_grasps_xy_m[False]))},
             **{key: value for name, times in self.metrics.items() for key, value in times.summary(name).items()},
         }
 
@@ -260,17 +267,25 @@ def _failure_table(cells: dict, tasks: list[str], splits: list[str]) -> list[str
     """Failed episodes per task x split by how far they got toward the target (episodes logged with `reach`)."""
     rows = []
     for task, split in ((t, s) for t in tasks for s in splits):
-        stages = (cells.get((task, split)) or {}).get("failure_stages")
+        cell = cells.get((task, split)) or {}
+        stages = cell.get("failure_stages")
         if stages:
             counts = " | ".join(str(stages[stage]) for stage in FAILURE_STAGES)
-            rows.append(f"| {task} | {split} | {sum(stages.values())} | {counts} |")
+            offsets = " / ".join(_millimetres(cell.get(f"first_grasp_xy_median_m_{outcome}"))
+                                 for outcome in ("failure", "success"))
+            rows.append(f"| {task} | {split} | {sum(stages.values())} | {counts} | {offsets} |")
     if not rows:
         return []
     caption = (f"Failed episodes by how far they got: no hand within {100 * REACHED_M:.0f} cm of the target's "
                f"centre; a hand there but the target moved less than {100 * MOVED_M:.0f} cm; the target moved, "
-               "no success.")
-    return ["", caption, "", "| task | split | failed | not reached | reached, not moved | moved, no success |",
-            "|---|---|---|---|---|---|", *rows]
+               "no success. Then the median horizontal distance from the target's centre at which the first grasp "
+               "of it closed, in failed and in successful episodes.")
+    return ["", caption, "", "| task | split | failed | not reached | reached, not moved | moved, no success "
+            "| first grasp off centre (mm), failed / succeeded |", "|---|---|---|---|---|---|---|", *rows]
+
+
+def _millimetres(value_m: float | None) -> str:
+    return "-" if value_m is None else f"{1000 * value_m:.0f}"
 
 
 def _seconds(value: float | None) -> str:
