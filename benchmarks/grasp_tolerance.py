@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import os
-from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 from tqdm import tqdm
@@ -65,6 +64,7 @@ def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float) -> list
 
 def main() -> None:
     from lerobot_tavis.dataset_tools.raw import Manifest
+    from lerobot_tavis.dataset_tools.workers import executor
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--raw", required=True, help="a `tavis record` directory")
@@ -82,10 +82,9 @@ def main() -> None:
         raise SystemExit(f"{args.raw} holds no kept episode")
     shifts_m = [np.zeros(3)] + [cm / 100 * np.asarray(unit, dtype=float)
                                 for cm in args.offsets_cm for unit in DIRECTIONS.values()]
-    with ProcessPoolExecutor(args.workers) as pool:
-        replays = pool.map(replay_shifted, [os.path.join(args.raw, e.file) for e in kept], [shifts_m] * len(kept),
-                           [args.hold_s] * len(kept))
-        outcomes = list(tqdm(replays, total=len(kept), desc="replays", unit="demonstration"))
+    with executor(args.workers) as pool:  # the project's: spawned workers that die with this process
+        replays = [pool.submit(replay_shifted, os.path.join(args.raw, e.file), shifts_m, args.hold_s) for e in kept]
+        outcomes = [replay.result() for replay in tqdm(replays, desc="replays", unit="demonstration")]
     successes = np.array(outcomes).sum(axis=0)  # per shift, over the episodes
     tasks = sorted({entry.task for entry in kept})
     print(f"{len(kept)} demonstrations of {', '.join(tasks)} ({manifest.robot}, {manifest.split}), "

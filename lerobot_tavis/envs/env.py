@@ -79,7 +79,8 @@ class TavisEnv(gym.Env):
     `info["conditions"]` holds the parts of the task's success rule (`Task.evaluate` less "success", which is
     `info["is_success"]`), e.g. `{"target_lifted": True, "target_slow": False, "target_height_m": 1.31, ...}`, and
     `info["reach"]` how far the episode has got toward a task's target so far (`lerobot_tavis.envs.reach`):
-    `{"closest_hand_m": 0.012, "target_moved_m": 0.25}`, or None for a task without one.
+    `{"closest_hand_m": 0.012, "target_moved_m": 0.25, "first_grasp_xy_m": 0.004}`, or None for a task without
+    one.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": physics.POLICY_HZ}
@@ -120,7 +121,8 @@ class TavisEnv(gym.Env):
         self._robot = make_robot(robot)
         self._sim: _Sim | None = None
         self._facts: EpisodeFacts | None = None
-        self._reach: ReachTracker | None = None  # tasks with a target: how near the hands got, how far it moved
+        self._reach: ReachTracker | None = None  # tasks with a target: how near the hands got, how far it moved,
+        # how far off the first grasp of it closed
         self._steps = 0
         self._last_frames: dict[str, np.ndarray] | None = None
         self._success_s: float | None = None  # when the task first reported success in this episode

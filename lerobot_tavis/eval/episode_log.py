@@ -8,7 +8,8 @@ them at the env's rate (20 Hz in evaluation): GALT for successful episodes of he
 does, and the wrist lead of the final grasp for successful TAVIS-Hands episodes. The metric fields are also added
 to that step's `info`. Before them, `conditions` holds the final step's `info["conditions"]`: the parts of the
 task's success rule (`Task.evaluate`), and `reach` its `info["reach"]`: how near a hand came to the task's target
-and how far the target moved over the episode (`lerobot_tavis.envs.reach`); each is null when the env gave none
+and how far the target moved over the episode, and how far off its centre the first grasp of it closed
+(`lerobot_tavis.envs.reach`); each is null when the env gave none
 (an episode ended by an instability; `reach` also for a task without a target).
 """
 

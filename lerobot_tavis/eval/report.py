@@ -68,7 +68,7 @@ class Cell:
     metrics: dict[str, LeadTimes] = field(default_factory=lambda: {m.name: LeadTimes() for m in episode_metrics()})
     unstable: int = 0  # episodes ended by a simulator instability (counted as failures)
     failure_stages: Counter = field(default_factory=Counter)  # failed episodes with a `reach`, by stage
-    first_grasps_xy_m: dict[bool, list[float]] = field(default_factory=lambda: {True: [], False: []})  # by success
+    first_grasps_xy_m: dict[str, list[float]] = field(default_factory=lambda: {"failure": [], "success": []})
 
     def add(self, record: dict) -> None:
         """One scored episode record of the episode log."""
@@ -80,7 +80,7 @@ class Cell:
         if reach and not record["success"]:
             self.failure_stages[failure_stage(reach)] += 1
         if reach and reach.get("first_grasp_xy_m") is not None:
-            self.first_grasps_xy_m[bool(record["success"])].append(reach["first_grasp_xy_m"])
+            self.first_grasps_xy_m["success" if record["success"] else "failure"].append(reach["first_grasp_xy_m"])
 
     def summary(self) -> dict:
         k, n = sum(self.successes), len(self.successes)
@@ -91,8 +91,7 @@ class Cell:
             "failure_stages": {stage: self.failure_stages[stage] for stage in FAILURE_STAGES} if self.failure_stages
             else {},
             **{f"first_grasp_xy_median_m_{outcome}": float(np.median(values)) if values else None
-               for outcome, values in (("success", self.first_grasps_xy_m[True]),
-                                       ("failure", self.first_grasps_xy_m[False]))},
+               for outcome, values in self.first_grasps_xy_m.items()},
             **{key: value for name, times in self.metrics.items() for key, value in times.summary(name).items()},
         }
 
