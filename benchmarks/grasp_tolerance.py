@@ -37,9 +37,11 @@ def grasping_arm(actions: np.ndarray):
     return max(canonical.ARMS, key=travel)
 
 
-def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float) -> list[bool]:
+def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float) -> tuple[list[bool], float, float | None]:
     """Success of the raw episode at `path` replayed once per shift (m, canonical frame) of the grasping arm, its
-    last command held `hold_s` seconds more."""
+    last command held `hold_s` seconds more; and, from the replay as recorded (no shift, no hold), how far the
+    target had moved (m) when the grasping arm's gripper command first turned closed, and how far above the task's
+    success height its centre was at the recording's last step (m; None for a task without a height rule)."""
     from lerobot_tavis.dataset_tools.raw import load_episode
     from lerobot_tavis.envs.env import TavisEnv
 
@@ -58,8 +60,16 @@ def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float) -> list
             if terminated or truncated:
                 break
         results.append(success)
+    env.reset(seed=episode.seed)
+    moved_at_close_m = None
+    for action in episode.actions:
+        *_, info = env.step(action)
+        if moved_at_close_m is None and action[arm.gripper] > 0.0:
+            moved_at_close_m = info["reach"]["target_moved_m"]
+    height = info["conditions"].get("target_height_m")
+    margin_m = None if height is None else height - env.task_object.success_height_m
     env.close()
-    return results
+    return results, moved_at_close_m or 0.0, margin_m
 
 
 def main() -> None:
@@ -85,7 +95,9 @@ def main() -> None:
     with executor(args.workers) as pool:  # the project's: spawned workers that die with this process
         replays = [pool.submit(replay_shifted, os.path.join(args.raw, e.file), shifts_m, args.hold_s) for e in kept]
         outcomes = [replay.result() for replay in tqdm(replays, desc="replays", unit="demonstration")]
-    successes = np.array(outcomes).sum(axis=0)  # per shift, over the episodes
+    successes = np.array([results for results, _, _ in outcomes]).sum(axis=0)  # per shift, over the episodes
+    moved_cm = [100 * moved for _, moved, _ in outcomes]
+    margins_mm = [1000 * margin for _, _, margin in outcomes if margin is not None]
     tasks = sorted({entry.task for entry in kept})
     print(f"{len(kept)} demonstrations of {', '.join(tasks)} ({manifest.robot}, {manifest.split}), "
           "grasping arm's commanded position shifted\n")
@@ -94,6 +106,11 @@ def main() -> None:
     for i, cm in enumerate(args.offsets_cm):
         row = successes[1 + i * len(DIRECTIONS): 1 + (i + 1) * len(DIRECTIONS)]
         print(f"| {cm:g} | " + " | ".join(f"{n}/{len(kept)}" for n in row) + " |")
+    brushed = [moved for moved in moved_cm if moved > 0]
+    print(f"\nAs recorded: the target had moved before the gripper command closed in {len(brushed)} of {len(kept)} "
+          f"(by {max(brushed, default=0):.1f} cm at most, {sum(moved >= 2 for moved in moved_cm)} by 2 cm or more)"
+          + (f"; at the last step its centre was {min(margins_mm):.0f}-{max(margins_mm):.0f} mm above the success "
+             "height" if margins_mm else ""))
 
 
 if __name__ == "__main__":

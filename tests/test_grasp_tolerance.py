@@ -31,5 +31,7 @@ def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(tmp
     idle = next(a for a in canonical.ARMS if a is not arm)
     assert np.ptp(actions[:, arm.position], axis=0).max() > np.ptp(actions[:, idle.position], axis=0).max()
 
-    unshifted, far_below = probe.replay_shifted(path, [np.zeros(3), np.array([0.0, 0.0, -0.08])], hold_s=1.0)
+    (unshifted, far_below), moved_m, margin_m = probe.replay_shifted(path, [np.zeros(3), np.array([0.0, 0.0, -0.08])],
+                                                                     hold_s=1.0)
     assert unshifted and not far_below
+    assert 0.0 <= moved_m < 0.1 and 0.0 < margin_m < 0.05  # recordings end the moment the object is past the line
