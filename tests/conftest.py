@@ -1,4 +1,5 @@
 import os
+from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before anything imports mujoco
 
@@ -38,3 +39,18 @@ def run_steps(env, action, steps: int):
     for _ in range(steps):
         obs, *_ = env.step(np.asarray(action))
     return obs
+
+
+@pytest.fixture
+def benchmark_script():
+    """Loads a script of benchmarks/ as a module: benchmark_script("grasp_tolerance")."""
+    import importlib.util
+
+    def load(name: str):
+        path = Path(__file__).resolve().parents[1] / "benchmarks" / f"{name}.py"
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+
+    return load

@@ -1,27 +1,15 @@
 """benchmarks/grasp_tolerance.py: a demonstration replayed with its grasping arm shifted succeeds unshifted and
 after a moment's hold, and fails when the hand is sent far below the grasp."""
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools.raw import Manifest, load_episode
 from lerobot_tavis.dataset_tools.record import RecordConfig, record
 
-SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "grasp_tolerance.py"
 
-
-def _probe():
-    spec = importlib.util.spec_from_file_location("grasp_tolerance", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(tmp_path):
-    probe = _probe()
+def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(benchmark_script, tmp_path):
+    probe = benchmark_script("grasp_tolerance")
     record(RecordConfig(out_dir=tmp_path / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
            progress=False)
     entry = next(e for e in Manifest.load(tmp_path / "raw").episodes if e.file)

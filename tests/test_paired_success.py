@@ -1,20 +1,9 @@
 """benchmarks/paired_success.py: episodes paired by (task, split, seed) and the exact McNemar test."""
 
-import importlib.util
 import json
 import sys
-from pathlib import Path
 
 import pytest
-
-SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "paired_success.py"
-
-
-def _script():
-    spec = importlib.util.spec_from_file_location("paired_success", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def _log(folder, successes, first_seed=1000):
@@ -25,8 +14,8 @@ def _log(folder, successes, first_seed=1000):
         for i, s in enumerate(successes)))
 
 
-def test_pairs_by_seed_and_tests_the_discordant_episodes(tmp_path, monkeypatch, capsys):
-    script = _script()
+def test_pairs_by_seed_and_tests_the_discordant_episodes(benchmark_script, tmp_path, monkeypatch, capsys):
+    script = benchmark_script("paired_success")
     _log(tmp_path / "a", [True, True, True, False, False])
     _log(tmp_path / "b", [True, False, False, True, False, True], first_seed=1000)  # seed 1005: unpaired
     monkeypatch.setattr(sys, "argv", ["paired_success.py", str(tmp_path / "a"), str(tmp_path / "b")])
