@@ -33,6 +33,8 @@ from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split
 from lerobot_tavis.envs.vector import Frozen, LazyAsyncVectorEnv
 from lerobot_tavis.errors import FieldError
 
+MAX_NICENESS = 19  # Linux's lowest CPU priority; a process's niceness stops there
+
 
 @EnvConfig.register_subclass("tavis")
 @dataclass
@@ -67,6 +69,9 @@ class TavisEnvConfig(EnvConfig):
     # Sub-envs of an async batch that draw video frames (lerobot-eval films at most 10 episodes of a batch, from its
     # first sub-envs); the others skip the overview render that filming costs
     filmed_envs: int = 10
+    # Niceness added to each async env worker process (as `nice`, 0-19): a higher value lets the process that runs
+    # the policy go first when the cores are contended; 0 keeps the workers at this process's priority
+    worker_niceness: int = 0
     # Tasks of a suite that lerobot-eval runs at once (threads)
     max_parallel_tasks: int = 1
     # Skip gymnasium's env checker
@@ -82,6 +87,9 @@ class TavisEnvConfig(EnvConfig):
         height, width = checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, self.fps)
         checks.integer("filmed_envs", self.filmed_envs, 0)
+        if checks.integer("worker_niceness", self.worker_niceness, 0) > MAX_NICENESS:
+            raise FieldError("worker_niceness", f"must be an integer from 0 to {MAX_NICENESS}, "
+                                                f"got {self.worker_niceness!r}")
         self.features = {"action": PolicyFeature(FeatureType.ACTION, (canonical.ACTION_DIM,)),
                          "agent_pos": PolicyFeature(FeatureType.STATE, (canonical.ACTION_DIM,))}
         self.features_map = {"action": "action", "agent_pos": "observation.state"}
@@ -106,7 +114,8 @@ class TavisEnvConfig(EnvConfig):
                     probe = factory.func(task, **self.gym_kwargs)  # spaces only: builds no simulator
                     envs[suite][task_id] = LazyAsyncVectorEnv([factory] * n_envs, probe.observation_space,
                                                               probe.action_space, probe.metadata,
-                                                              filmed_envs=self.filmed_envs)
+                                                              filmed_envs=self.filmed_envs,
+                                                              worker_niceness=self.worker_niceness)
                 else:
                     envs[suite][task_id] = gym.vector.SyncVectorEnv(
                         [Frozen(factory)] * n_envs,

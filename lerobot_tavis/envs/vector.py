@@ -16,12 +16,15 @@ envs. This module gives the same two behaviours from classes that import only gy
   returns the filmed ones' frames alone, so that lerobot-eval films `min(filmed_envs, 10)` episodes. lerobot-eval
   also asks every sub-env for its `task_description` at each step, a round trip through all the workers (4.4 ms per
   step for 32 envs, one H100 machine); a prompt changes only at a reset, so it is asked once per reset.
+  `worker_niceness` lowers the workers' CPU priority (added to their niceness, as `nice`), so that the process that
+  runs the policy is not delayed by them when the cores are contended.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import gymnasium as gym
 
@@ -61,12 +64,18 @@ class Unfilmed(gym.Wrapper):
 @dataclass(frozen=True)
 class Frozen:
     """A sub-env factory whose env freezes after its episode (picklable by reference to this module); an env not
-    `filmed` renders no frame."""
+    `filmed` renders no frame. `niceness` is added to the niceness (as `nice`) of any process that calls it other
+    than `creator_pid`, the one that built it: gymnasium's AsyncVectorEnv also calls its first factory there, for the
+    spaces, and that process must keep its priority."""
 
     make: Callable[[], gym.Env]
     filmed: bool = True
+    niceness: int = 0
+    creator_pid: int = field(default_factory=os.getpid)
 
     def __call__(self) -> gym.Env:
+        if self.niceness and os.getpid() != self.creator_pid:
+            os.nice(self.niceness)
         env = FreezeAfterEpisodeEnd(self.make())
         return env if self.filmed else Unfilmed(env)
 
@@ -74,11 +83,13 @@ class Frozen:
 class LazyAsyncVectorEnv:
     """An AsyncVectorEnv of `Frozen(factory)` sub-envs, started on the first reset, step, call or attribute read.
     `observation_space`, `action_space` and `metadata` are those of one sub-env, given up front; sub-envs from
-    index `filmed_envs` on render no frame."""
+    index `filmed_envs` on render no frame; `worker_niceness` is added to each worker process's niceness (as
+    `nice`)."""
 
     def __init__(self, factories: list[Callable[[], gym.Env]], observation_space: gym.Space,
-                 action_space: gym.Space, metadata: dict, filmed_envs: int = 10):
-        self._factories = [Frozen(factory, filmed=index < filmed_envs) for index, factory in enumerate(factories)]
+                 action_space: gym.Space, metadata: dict, filmed_envs: int = 10, worker_niceness: int = 0):
+        self._factories = [Frozen(factory, filmed=index < filmed_envs, niceness=worker_niceness)
+                           for index, factory in enumerate(factories)]
         self._filmed_envs = filmed_envs
         self._env: gym.vector.AsyncVectorEnv | None = None
         self._task_descriptions: tuple[str, ...] | None = None  # the sub-envs' prompts since the last reset

@@ -38,6 +38,7 @@ from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
 
 METRICS = ("successes", "sum_rewards", "max_rewards")  # per-episode lists of lerobot-eval's per-task metrics
+ENV_WORKER_NICENESS = 10  # env workers yield contended cores to the policy's process, use idle ones; same outcomes
 
 
 @dataclass(frozen=True)
@@ -179,7 +180,8 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
         film = cfg.film_episodes if chunk.first_seed == cfg.seed else 0  # the task's first episodes only
         env = TavisEnvConfig(task=chunk.task, robot=cfg.robot, camera_mode=cfg.camera_mode, split=chunk.split,
                              image_size=cfg.image_size, episode_length_s=cfg.episode_length_s,
-                             episode_log=str(out / EPISODE_LOG_NAME), filmed_envs=film)
+                             episode_log=str(out / EPISODE_LOG_NAME), filmed_envs=film,
+                             worker_niceness=ENV_WORKER_NICENESS if cfg.device != "cpu" else 0)
         batches = EvalConfig(n_episodes=chunk.n, batch_size=batch, use_async_envs=batch > 1)
         evaluate(pipeline_config(env=env, eval=batches, policy=policy, output_dir=out, seed=chunk.first_seed,
                                  job_name=f"tavis_{chunk.task}_{chunk.split}"))

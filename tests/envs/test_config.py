@@ -1,7 +1,10 @@
 """`--env.type=tavis` as LeRobot uses it: registry, features, create_envs (sync and forkserver async), seeds."""
 
+import os
+from functools import partial
 from pathlib import Path
 
+import gymnasium as gym
 import numpy as np
 import pytest
 from lerobot.envs import utils as lerobot_env_utils
@@ -126,9 +129,35 @@ def test_an_async_batch_asks_its_workers_for_the_prompts_once_per_reset():
         vec.close()
 
 
+@pytest.mark.parametrize("worker_niceness", [3, 0])
+def test_async_workers_run_at_the_given_niceness_above_this_process(worker_niceness):
+    """Each worker process adds `worker_niceness` to the niceness it inherits (as `nice`); 0 leaves it equal. This
+    process keeps its own, though gymnasium's AsyncVectorEnv calls the first sub-env factory here too."""
+    own_niceness = os.nice(0)
+    probe = gym.make("CartPole-v1")  # tiny, and picklable by reference to gymnasium
+    vec = LazyAsyncVectorEnv([partial(gym.make, "CartPole-v1")] * 2, probe.observation_space, probe.action_space,
+                             probe.metadata, worker_niceness=worker_niceness)
+    try:
+        vec.reset(seed=0)
+        workers = [os.getpriority(os.PRIO_PROCESS, process.pid) for process in vec._started().processes]
+    finally:
+        vec.close()
+    assert os.nice(0) == own_niceness
+    assert workers == [own_niceness + worker_niceness] * 2
+
+
 def test_a_negative_filmed_env_count_is_refused():
     with pytest.raises(ValueError, match="filmed_envs must be an integer >= 0"):
         TavisEnvConfig(filmed_envs=-1)
+
+
+@pytest.mark.parametrize("worker_niceness", [-1, 20])
+def test_a_worker_niceness_outside_0_to_19_is_refused(worker_niceness):
+    from lerobot_tavis.errors import FieldError
+
+    with pytest.raises(ValueError, match="worker_niceness must be an integer") as error:
+        TavisEnvConfig(worker_niceness=worker_niceness)
+    assert isinstance(error.value, FieldError) and error.value.field == "worker_niceness"
 
 
 def test_the_new_rollout_option_is_lerobots():
