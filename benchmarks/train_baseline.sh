@@ -12,7 +12,8 @@
 # evaluation's jobs sharing the GPU, each playing EVAL_EPISODES / EVAL_JOBS episodes in batches of EVAL_BATCH envs),
 # FILM (episodes filmed per evaluation: 2, as each filmed sub-env also renders the overview), EVAL_OPTIONS (more
 # `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1" for
-# ACT's temporal ensembling), EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), CHECKPOINTS (which
+# ACT's temporal ensembling), TRAIN_OPTIONS (more lerobot-train arguments, e.g. "--policy.chunk_size=40
+# --policy.n_action_steps=20"), EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), CHECKPOINTS (which
 # `eval` takes: all, or last), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
@@ -47,6 +48,7 @@ EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
 SEED=${SEED:-1000}
 CHECKPOINTS=${CHECKPOINTS:-all}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
+read -ra train_options <<< "${TRAIN_OPTIONS:-}"
 WORK=${WORK:-/tmp/tavis_baseline}
 export MUJOCO_GL=${MUJOCO_GL:-egl}
 case "$CONDITION" in
@@ -82,7 +84,7 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]
   lerobot-train --config_path="$(tavis presets "act_${CONDITION}_compact")" \
     --dataset.repo_id="local/$(basename "$dataset")" --dataset.root="$dataset" --dataset.video_backend="$BACKEND" \
     --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true --num_workers="$WORKERS" \
-    --seed="$SEED" --log_freq=100 --output_dir="$out" "$@"
+    --seed="$SEED" --log_freq=100 --output_dir="$out" "${train_options[@]}" "$@"
 }
 
 evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the id split of TASK
