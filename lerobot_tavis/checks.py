@@ -21,10 +21,12 @@ def _is_real(value) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
-def integer(field: str, value, minimum: int) -> int:
-    """`value` as an int, refused unless it is a whole number >= `minimum`."""
-    if not (_is_real(value) and math.isfinite(value) and float(value).is_integer() and value >= minimum):
-        raise FieldError(field, f"must be an integer >= {minimum}, got {value!r}")
+def integer(field: str, value, minimum: int, maximum: int | None = None) -> int:
+    """`value` as an int, refused unless it is a whole number >= `minimum` (and <= `maximum`, if given)."""
+    if not (_is_real(value) and math.isfinite(value) and float(value).is_integer() and value >= minimum
+            and (maximum is None or value <= maximum)):
+        bounds = f">= {minimum}" if maximum is None else f"from {minimum} to {maximum}"
+        raise FieldError(field, f"must be an integer {bounds}, got {value!r}")
     return int(value)
 
 

@@ -87,9 +87,7 @@ class TavisEnvConfig(EnvConfig):
         height, width = checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, self.fps)
         checks.integer("filmed_envs", self.filmed_envs, 0)
-        if checks.integer("worker_niceness", self.worker_niceness, 0) > MAX_NICENESS:
-            raise FieldError("worker_niceness", f"must be an integer from 0 to {MAX_NICENESS}, "
-                                                f"got {self.worker_niceness!r}")
+        checks.integer("worker_niceness", self.worker_niceness, 0, MAX_NICENESS)
         self.features = {"action": PolicyFeature(FeatureType.ACTION, (canonical.ACTION_DIM,)),
                          "agent_pos": PolicyFeature(FeatureType.STATE, (canonical.ACTION_DIM,))}
         self.features_map = {"action": "action", "agent_pos": "observation.state"}

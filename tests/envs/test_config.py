@@ -155,7 +155,7 @@ def test_a_negative_filmed_env_count_is_refused():
 def test_a_worker_niceness_outside_0_to_19_is_refused(worker_niceness):
     from lerobot_tavis.errors import FieldError
 
-    with pytest.raises(ValueError, match="worker_niceness must be an integer") as error:
+    with pytest.raises(ValueError, match="worker_niceness must be an integer from 0 to 19") as error:
         TavisEnvConfig(worker_niceness=worker_niceness)
     assert isinstance(error.value, FieldError) and error.value.field == "worker_niceness"
 
