@@ -7,9 +7,9 @@ resident memory (RSS, which counts a shared library once per process that maps i
 which splits shared pages among the processes sharing them: what the tree really holds), and the largest process
 count. CPU time (`cpu_s`) is the larger of two counts of the tree's user + system time: the times the operating
 system adds to a parent when it waits for a child, and the sum over every process sampled in the tree of its own
-time when last seen. The first alone misses processes whose parent never waits for them (a forkserver's workers:
-the env workers of a policy evaluation, which it once under-counted by most of their time); the second misses a
-process's last interval and processes that live less than one. `cores` is the number of CPUs the command may run
+time when last seen. The first alone misses processes whose parent never waits for them (a forkserver's workers,
+such as a policy evaluation's env workers: this script once left them out entirely); the second misses a process's
+last interval and processes that live less than one. `cores` is the number of CPUs the command may run
 on (its CPU affinity, e.g. under `taskset`), `machine_busy_percent` the tree's CPU time over those cores, and
 `cores_busy_percent` how busy those cores were over the run whatever ran on them (/proc/stat). Linux only.
 """
