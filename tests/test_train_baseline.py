@@ -71,3 +71,10 @@ def test_seed_reaches_lerobot_train_and_defaults_to_its_own(tmp_path):
 
     assert train_seeds(tmp_path / "default") == ["1000"]
     assert train_seeds(tmp_path / "replicate", SEED="2000") == ["2000"]
+
+
+def test_train_options_reach_lerobot_train_before_the_modes_own_arguments(tmp_path):
+    calls = _run(tmp_path, "train", TRAIN_OPTIONS="--policy.chunk_size=40 --policy.n_action_steps=20", STEPS="800")
+    trains = [call.split(" | ")[0] for call in calls if call.startswith("lerobot-train")]
+    assert len(trains) == 1
+    assert "--policy.chunk_size=40 --policy.n_action_steps=20 --steps=800" in trains[0]
