@@ -87,6 +87,11 @@ class RayExecutor:
             self._ray.shutdown()
 
 
+def usable_cores() -> int:
+    """The CPUs this process may run on (its affinity: `taskset`, a container's cpuset), not the machine's count."""
+    return len(os.sched_getaffinity(0))
+
+
 def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0):
     """The pool for `backend`: local spawned processes (MuJoCo's EGL contexts and torch do not survive a fork), or
     inline for one worker; Ray ignores `workers` and runs what the cluster's resources allow."""

@@ -31,7 +31,7 @@ from tqdm import tqdm
 
 from lerobot_tavis.atomic import write_text
 from lerobot_tavis.dataset_tools.staging import staged_directory
-from lerobot_tavis.dataset_tools.workers import executor
+from lerobot_tavis.dataset_tools.workers import executor, usable_cores
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
@@ -202,7 +202,7 @@ def _share_cores(jobs: int) -> None:
     on the CPU keeps torch's default, as its results would depend on the thread count, and so on `--workers`."""
     import torch
 
-    torch.set_num_threads(max(1, len(os.sched_getaffinity(0)) // jobs))
+    torch.set_num_threads(max(1, usable_cores() // jobs))
 
 
 def _close_envs() -> None:

@@ -13,7 +13,6 @@ and beside each evaluation's videos a copy with the episode's GALT events drawn 
 from __future__ import annotations
 
 import json
-import os
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -345,6 +344,7 @@ def write_report(root: str | Path, workers: int | None = None) -> list[Path]:
     """Build the report of every evaluation under `root` and write it there, with an annotated copy of each
     episode video (`lerobot_tavis.eval.annotate`, `workers` processes: default every core this process may use);
     returns the written files."""
+    from lerobot_tavis.dataset_tools.workers import usable_cores
     from lerobot_tavis.eval.annotate import annotate_videos
 
     root = Path(root)
@@ -352,4 +352,4 @@ def write_report(root: str | Path, workers: int | None = None) -> list[Path]:
     written = plot(report, root)
     written.append(write_text(root / "results.json", json.dumps(report, indent=2) + "\n"))
     written.append(write_text(root / "results.md", markdown(report)))
-    return written + annotate_videos(eval_dirs(root), len(os.sched_getaffinity(0)) if workers is None else workers)
+    return written + annotate_videos(eval_dirs(root), usable_cores() if workers is None else workers)
