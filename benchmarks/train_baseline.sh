@@ -26,7 +26,9 @@
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's
-#   libraries can be found (PyAV's bundled copy, tools/pyav_ffmpeg.sh), else with PyAV.
+#   libraries can be found (PyAV's bundled copy, tools/pyav_ffmpeg.sh), else with PyAV. A run whose logged loss
+#   becomes NaN (float16 AMP overflowing, once in 14 runs) is stopped there and fails (exit 3) instead of
+#   spending the slot on NaN checkpoints.
 # - eval: `tavis eval --policy` (LeRobot's evaluation loop, EVAL_JOBS runs of it sharing the GPU: one loop over
 #   48 envs stepped about 200 envs/s on 16 cores) on every complete checkpoint not yet evaluated (or the last
 #   alone: CHECKPOINTS=last), seeds from 1000, side by side; it can run beside `train`, which marks a checkpoint
@@ -79,13 +81,30 @@ convert() {  # convert RAW_DIR DATASET_DIR
     --cameras "$CAMERAS" "${NECK[@]}" --workers "$WORKERS" --overwrite
 }
 
-train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]
-  local dataset=$1 out=$2
+# Copies its input to its output as it comes; at the first NaN loss in LeRobot's log lines it stops the processes
+# whose command line matches its argument (lerobot-train ignores a closed pipe) and exits 3.
+PASS_UNTIL_NAN_LOSS='import os, subprocess, sys
+seen = b""
+while chunk := os.read(0, 1 << 16):
+    os.write(1, chunk)
+    if b" loss:nan " in seen[-16:] + chunk:
+        subprocess.run(["pkill", "-TERM", "-f", "--", sys.argv[1]])
+        sys.exit(3)
+    seen = chunk'
+
+train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]: fails with 3, the run stopped, at a NaN loss
+  local dataset=$1 out=$2 status=0
   shift 2
   lerobot-train --config_path="$(tavis presets "act_${CONDITION}_compact")" \
     --dataset.repo_id="local/$(basename "$dataset")" --dataset.root="$dataset" --dataset.video_backend="$BACKEND" \
     --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true --num_workers="$WORKERS" \
-    --seed="$SEED" --log_freq=100 --output_dir="$out" "${train_options[@]}" "$@"
+    --seed="$SEED" --log_freq=100 --output_dir="$out" "${train_options[@]}" "$@" 2>&1 \
+    | python3 -c "$PASS_UNTIL_NAN_LOSS" "--output_dir=$out( |$)" || status=$?
+  if (( status == 3 )); then
+    echo "train_baseline: the training loss became NaN; training stopped. Train again with another SEED, or" \
+      "without AMP (TRAIN_OPTIONS=--policy.use_amp=false)." >&2
+  fi
+  return "$status"
 }
 
 evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the id split of TASK

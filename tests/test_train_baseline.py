@@ -78,3 +78,26 @@ def test_train_options_reach_lerobot_train_before_the_modes_own_arguments(tmp_pa
     trains = [call.split(" | ")[0] for call in calls if call.startswith("lerobot-train")]
     assert len(trains) == 1
     assert "--policy.chunk_size=40 --policy.n_action_steps=20 --steps=800" in trains[0]
+
+
+def test_a_nan_loss_stops_the_training_run_and_fails_with_a_clear_message(tmp_path):
+    stubs = tmp_path / "bin"
+    stubs.mkdir()
+    (stubs / "tavis").write_text("#!/usr/bin/env bash\necho /dev/null\n")
+    # LeRobot's log lines, the third one NaN, then a run that would go on for a minute unless stopped.
+    (stubs / "lerobot-train").write_text("""#!/usr/bin/env bash
+for step in 100 200; do echo "INFO ot_train.py:641 step:$step smpl:13K loss:0.9 grdn:31.6 lr:1.0e-04" >&2; done
+echo "INFO ot_train.py:641 step:300 smpl:38K loss:nan grdn:nan lr:9.9e-05" >&2
+sleep 60 > /dev/null 2>&1 &
+wait $!
+touch "$FINISHED"
+""")
+    for stub in stubs.iterdir():
+        stub.chmod(0o755)
+    env = {**os.environ, "PATH": f"{stubs}:{os.environ['PATH']}", "WORK": str(tmp_path / "work"), "WORKERS": "4",
+           "FINISHED": str(tmp_path / "finished")}
+    run = subprocess.run(["bash", str(SCRIPT), "train"], env=env, capture_output=True, text=True, timeout=30)
+    assert run.returncode == 3
+    assert "step:200 smpl:13K loss:0.9" in run.stdout  # the log passes through up to the NaN
+    assert "the training loss became NaN; training stopped" in run.stderr
+    assert not (tmp_path / "finished").exists()
