@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import statistics
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -32,39 +33,65 @@ def first_change(values: list[np.ndarray], tolerance: float, reduce=np.max) -> i
     return next((index for index, value in enumerate(values) if reduce(np.abs(value - values[0])) > tolerance), None)
 
 
-def main() -> None:
+@dataclass(frozen=True)
+class OpeningStall:
+    """One episode's opening, in frames from its first: where the state, each camera and the arms' action change
+    (None: not within the frames read)."""
+
+    episode: int
+    state: int | None
+    images: dict[str, int | None]
+    arm_action: int | None
+    frames_read: int
+
+    @property
+    def frames(self) -> int:
+        """Frames from the first during which no input changes."""
+        changes = [index for index in (self.state, *self.images.values()) if index is not None]
+        return min(changes, default=self.frames_read)
+
+
+def opening_stalls(root: Path, frames: int = 80) -> tuple[list[OpeningStall], float]:
+    """Every episode's opening stall in the LeRobotDataset at `root`, reading its first `frames` frames; and the
+    dataset's fps."""
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     from lerobot_tavis import canonical
 
+    if not (root / "meta" / "info.json").is_file():
+        raise SystemExit(f"{root} is not a LeRobotDataset folder (no meta/info.json)")
+    dataset = LeRobotDataset(f"local/{root.name}", root=root, video_backend="pyav")
+    arms = np.r_[canonical.LEFT.position, canonical.LEFT.quaternion, canonical.RIGHT.position,
+                 canonical.RIGHT.quaternion]
+    episode_of_frame = np.asarray(dataset.hf_dataset["episode_index"])
+    stalls = []
+    for episode in np.unique(episode_of_frame):
+        items = [dataset[int(index)] for index in np.flatnonzero(episode_of_frame == episode)[:frames]]
+        stalls.append(OpeningStall(
+            episode=int(episode),
+            state=first_change([item["observation.state"].numpy() for item in items], STATE_TOLERANCE),
+            images={camera.rsplit(".", 1)[-1]: first_change([item[camera].numpy() for item in items],
+                                                            IMAGE_TOLERANCE, np.mean)
+                    for camera in dataset.meta.camera_keys},
+            arm_action=first_change([item["action"].numpy()[arms] for item in items], ARM_ACTION_TOLERANCE),
+            frames_read=len(items)))
+    return stalls, dataset.fps
+
+
+def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("root", type=Path, help="a LeRobotDataset folder written by `tavis convert`")
     parser.add_argument("--frames", type=int, default=80, help="frames read from the start of each episode")
     args = parser.parse_args()
-    if not (args.root / "meta" / "info.json").is_file():
-        parser.error(f"{args.root} is not a LeRobotDataset folder (no meta/info.json)")
-
-    dataset = LeRobotDataset(f"local/{args.root.name}", root=args.root, video_backend="pyav")
-    cameras = list(dataset.meta.camera_keys)
-    arms = np.r_[canonical.LEFT.position, canonical.LEFT.quaternion, canonical.RIGHT.position,
-                 canonical.RIGHT.quaternion]
-    episode_of_frame = np.asarray(dataset.hf_dataset["episode_index"])
-    stalls_s = []
-    print(f"{args.root}: {dataset.meta.total_episodes} episodes at {dataset.fps} fps, cameras {cameras}")
-    for episode in np.unique(episode_of_frame):
-        frames = [dataset[int(index)] for index in np.flatnonzero(episode_of_frame == episode)[:args.frames]]
-        state = first_change([frame["observation.state"].numpy() for frame in frames], STATE_TOLERANCE)
-        images = {camera: first_change([frame[camera].numpy() for frame in frames], IMAGE_TOLERANCE, np.mean)
-                  for camera in cameras}
-        arm = first_change([frame["action"].numpy()[arms] for frame in frames], ARM_ACTION_TOLERANCE)
-        changes = [index for index in (state, *images.values()) if index is not None]
-        stall = min(changes, default=len(frames))
-        stalls_s.append(stall / dataset.fps)
-        shown = ", ".join(f"{camera.rsplit('.', 1)[-1]} {index}" for camera, index in images.items())
-        print(f"episode {episode}: inputs unchanged for {stall} frames (state changes at {state}; images: {shown});"
-              f" arm action moves at {arm}")
-    print(f"opening stall: {min(stalls_s):.2f}-{max(stalls_s):.2f} s, median {statistics.median(stalls_s):.2f} s "
-          f"over {len(stalls_s)} episodes (None: no change within {args.frames} frames)")
+    stalls, fps = opening_stalls(args.root, args.frames)
+    print(f"{args.root}: {len(stalls)} episodes at {fps} fps")
+    for stall in stalls:
+        images = ", ".join(f"{camera} {index}" for camera, index in stall.images.items())
+        print(f"episode {stall.episode}: inputs unchanged for {stall.frames} frames (state changes at {stall.state}; "
+              f"images: {images}); arm action moves at {stall.arm_action}")
+    seconds = [stall.frames / fps for stall in stalls]
+    print(f"opening stall: {min(seconds):.2f}-{max(seconds):.2f} s, median {statistics.median(seconds):.2f} s "
+          f"over {len(seconds)} episodes (None: no change within {args.frames} frames)")
 
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
 import os
+import sys
 from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before anything imports mujoco
@@ -42,7 +43,7 @@ def run_steps(env, action, steps: int):
 
 
 @pytest.fixture
-def benchmark_script():
+def benchmark_script(monkeypatch):
     """Loads a script of benchmarks/ as a module: benchmark_script("grasp_tolerance")."""
     import importlib.util
 
@@ -50,6 +51,7 @@ def benchmark_script():
         path = Path(__file__).resolve().parents[1] / "benchmarks" / f"{name}.py"
         spec = importlib.util.spec_from_file_location(name, path)
         module = importlib.util.module_from_spec(spec)
+        monkeypatch.setitem(sys.modules, name, module)  # dataclasses look their module up there
         spec.loader.exec_module(module)
         return module
 
