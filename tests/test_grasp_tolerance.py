@@ -1,5 +1,5 @@
 """benchmarks/grasp_tolerance.py: a demonstration replayed with its grasping arm shifted succeeds unshifted and
-after a moment's hold, and fails when the hand is sent far below the grasp."""
+after a moment's hold, and fails when the hand is sent far below the grasp or turned round."""
 
 import numpy as np
 
@@ -19,7 +19,9 @@ def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(ben
     idle = next(a for a in canonical.ARMS if a is not arm)
     assert np.ptp(actions[:, arm.position], axis=0).max() > np.ptp(actions[:, idle.position], axis=0).max()
 
-    (unshifted, far_below), moved_m, margin_m = probe.replay_shifted(path, [np.zeros(3), np.array([0.0, 0.0, -0.08])],
-                                                                     hold_s=1.0)
-    assert unshifted and not far_below
+    (unshifted, far_below, no_turn, half_turn), moved_m, margin_m = probe.replay_shifted(
+        path, [np.zeros(3), np.array([0.0, 0.0, -0.08])], hold_s=1.0,
+        rotations=[probe.rotation_quaternion((0, 0, 1), 0.0), probe.rotation_quaternion((0, 0, 1), 180.0)])
+    assert unshifted[0] and not far_below[0] and unshifted[1] < 0.05
+    assert no_turn == unshifted and not half_turn[0]  # a hand turned round cannot grasp
     assert 0.0 <= moved_m < 0.1 and 0.0 < margin_m < 0.05  # recordings end the moment the object is past the line
