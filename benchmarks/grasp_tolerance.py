@@ -14,7 +14,9 @@ so offset 0 must succeed; the offset at which success falls off is the precision
 `--rotations-deg`, the grasping arm's commanded orientation is also turned, for the whole episode, by each angle
 about +x, -x, +y, -y, +z and -z of the same frame (the other commands as recorded). Prints Markdown tables: success
 per offset (or rotation) and direction over the episodes, and for rotations also how many replays never brought a
-hand within 5 cm of the target's centre (the report's "not reached"). Nothing is rendered.
+hand within 5 cm of the target's centre (the report's "not reached"). Also prints how much the grasping arm's
+commanded orientation at the grasp varies over the demonstrations: what a policy has to read off its images.
+Nothing is rendered.
 """
 
 from __future__ import annotations
@@ -39,6 +41,20 @@ def grasping_arm(actions: np.ndarray):
         return float(np.sum(np.linalg.norm(np.diff(actions[:, arm.position], axis=0), axis=1)))
 
     return max(canonical.ARMS, key=travel)
+
+
+def grasp_orientation(actions: np.ndarray) -> tuple[str, np.ndarray]:
+    """The grasping arm's side and its commanded orientation (unit quaternion w, x, y, z) at the first step whose
+    gripper command is closed (> 0), from `actions` (T, 19)."""
+    arm = grasping_arm(actions)
+    quaternion = actions[int(np.argmax(actions[:, arm.gripper] > 0.0)), arm.quaternion].astype(float)
+    return arm.side, quaternion / np.linalg.norm(quaternion)
+
+
+def orientation_spread_deg(quaternions: list[np.ndarray]) -> np.ndarray:
+    """Angles (degrees) from each of `quaternions` to the most central one (the least median angle to the rest)."""
+    angles = np.degrees(2 * np.arccos(np.clip(np.abs(np.asarray(quaternions) @ np.asarray(quaternions).T), 0, 1)))
+    return angles[int(np.argmin(np.median(angles, axis=1)))]
 
 
 def rotation_quaternion(axis, degrees: float) -> np.ndarray:
@@ -99,7 +115,7 @@ def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float,
 
 
 def main() -> None:
-    from lerobot_tavis.dataset_tools.raw import Manifest
+    from lerobot_tavis.dataset_tools.raw import Manifest, load_episode
     from lerobot_tavis.dataset_tools.workers import executor
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -147,6 +163,13 @@ def main() -> None:
             columns = range(first + i * len(DIRECTIONS), first + (i + 1) * len(DIRECTIONS))
             print(f"| {degrees:g} | " + " | ".join(f"{successes[c]}/{len(kept)} ({not_reached[c]})" for c in columns)
                   + " |")
+    grasps = [grasp_orientation(load_episode(os.path.join(args.raw, entry.file)).actions) for entry in kept]
+    for side in sorted({side for side, _ in grasps}):
+        spread = orientation_spread_deg([quaternion for hand, quaternion in grasps if hand == side])
+        print(f"\nGrasp orientation ({side} hand, {len(spread)} demonstrations): {np.median(spread):.0f} degrees from "
+              f"the most central one at the median, {np.percentile(spread, 90):.0f} at the 90th percentile, "
+              f"{spread.max():.0f} at most (commanded when the gripper closes)", end="")
+    print()
     brushed = [moved for moved in moved_cm if moved > 0]
     print(f"\nAs recorded: the target had moved before the gripper command closed in {len(brushed)} of {len(kept)} "
           f"(by {max(brushed, default=0):.1f} cm at most, {sum(moved >= 2 for moved in moved_cm)} by 2 cm or more)"
