@@ -1,5 +1,6 @@
 """How far off a hand may be and still grasp: each recorded demonstration replayed with the grasping arm's
-end-effector position commands shifted by a constant offset, and whether the task still succeeds.
+end-effector position commands shifted by a constant offset (or its orientation commands turned by a constant
+angle), and whether the task still succeeds.
 
     python benchmarks/grasp_tolerance.py --raw RAW_DIR [--offsets-cm 0.25 0.5 1 1.5 2] [--rotations-deg 5 10 20]
                                          [--episodes 8] [--hold-s 2] [--workers N]
