@@ -54,14 +54,10 @@ def grasp_orientation(actions: np.ndarray) -> tuple[str, np.ndarray]:
 
 def orientation_spread_deg(quaternions: list[np.ndarray]) -> np.ndarray:
     """Angles (degrees) from each of `quaternions` to the most central one (the least median angle to the rest)."""
-    angles = np.degrees(2 * np.arccos(np.clip(np.abs(np.asarray(quaternions) @ np.asarray(quaternions).T), 0, 1)))
+    from lerobot_tavis.envs.transforms import quat_angle_rad
+
+    angles = np.degrees([[quat_angle_rad(a, b) for b in quaternions] for a in quaternions])
     return angles[int(np.argmin(np.median(angles, axis=1)))]
-
-
-def rotation_quaternion(axis, degrees: float) -> np.ndarray:
-    """The unit quaternion (w, x, y, z) turning by `degrees` about `axis`."""
-    half = np.radians(degrees) / 2
-    return np.concatenate([[np.cos(half)], np.sin(half) * np.asarray(axis, dtype=float) / np.linalg.norm(axis)])
 
 
 def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float,
@@ -72,10 +68,9 @@ def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float,
     and, from the replay as recorded (no shift, no hold), how far the target had moved (m) when the grasping arm's
     gripper command first turned closed, and how far above the task's success height its centre was at the
     recording's last step (m; None for a task without a height rule)."""
-    import mujoco
-
     from lerobot_tavis.dataset_tools.raw import load_episode
     from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.envs.transforms import quat_multiply
 
     episode = load_episode(path)
     env = TavisEnv(episode.task, episode.robot, split=episode.split, fps=episode.fps, cameras=())
@@ -89,9 +84,7 @@ def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float,
     for rotation in rotations:
         actions = held.copy()
         for action in actions:
-            turned = np.empty(4)
-            mujoco.mju_mulQuat(turned, rotation, action[arm.quaternion].astype(float))
-            action[arm.quaternion] = turned
+            action[arm.quaternion] = quat_multiply(rotation, action[arm.quaternion])
         variants.append(actions)
     results = []
     for actions in variants:
@@ -118,6 +111,7 @@ def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float,
 def main() -> None:
     from lerobot_tavis.dataset_tools.raw import Manifest, load_episode
     from lerobot_tavis.dataset_tools.workers import executor
+    from lerobot_tavis.envs.transforms import axis_angle_quat
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--raw", required=True, help="a `tavis record` directory")
@@ -137,7 +131,8 @@ def main() -> None:
         raise SystemExit(f"{args.raw} holds no kept episode")
     shifts_m = [np.zeros(3)] + [cm / 100 * np.asarray(unit, dtype=float)
                                 for cm in args.offsets_cm for unit in DIRECTIONS.values()]
-    rotations = [rotation_quaternion(axis, degrees) for degrees in args.rotations_deg for axis in DIRECTIONS.values()]
+    rotations = [axis_angle_quat(axis, np.radians(degrees)) for degrees in args.rotations_deg
+                 for axis in DIRECTIONS.values()]
     with executor(args.workers) as pool:  # the project's: spawned workers that die with this process
         replays = [pool.submit(replay_shifted, os.path.join(args.raw, e.file), shifts_m, args.hold_s, rotations)
                    for e in kept]

@@ -1,12 +1,12 @@
 """benchmarks/grasp_tolerance.py: a demonstration replayed with its grasping arm shifted succeeds unshifted and
 after a moment's hold, and fails when the hand is sent far below the grasp or turned round."""
 
-import mujoco
 import numpy as np
 
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools.raw import Manifest, load_episode
 from lerobot_tavis.dataset_tools.record import RecordConfig, record
+from lerobot_tavis.envs.transforms import axis_angle_quat, quat_multiply
 
 
 def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(benchmark_script, tmp_path):
@@ -22,13 +22,12 @@ def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(ben
 
     (unshifted, far_below, no_turn, half_turn), moved_m, margin_m = probe.replay_shifted(
         path, [np.zeros(3), np.array([0.0, 0.0, -0.08])], hold_s=1.0,
-        rotations=[probe.rotation_quaternion((0, 0, 1), 0.0), probe.rotation_quaternion((0, 0, 1), 180.0)])
+        rotations=[axis_angle_quat((0, 0, 1), 0.0), axis_angle_quat((0, 0, 1), np.pi)])
     assert unshifted[0] and not far_below[0] and unshifted[1] < 0.05
     assert no_turn == unshifted and not half_turn[0]  # a hand turned round cannot grasp
 
     side, quaternion = probe.grasp_orientation(actions)
     assert side == arm.side and np.isclose(np.linalg.norm(quaternion), 1.0)
-    turned = np.empty(4)
-    mujoco.mju_mulQuat(turned, probe.rotation_quaternion((1, 0, 0), 30.0), quaternion)
+    turned = quat_multiply(axis_angle_quat((1, 0, 0), np.radians(30.0)), quaternion)
     assert np.allclose(probe.orientation_spread_deg([quaternion, quaternion, turned]), [0.0, 0.0, 30.0], atol=1e-4)
     assert 0.0 <= moved_m < 0.1 and 0.0 < margin_m < 0.05  # recordings end the moment the object is past the line
