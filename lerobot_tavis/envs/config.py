@@ -100,16 +100,21 @@ class TavisEnvConfig(EnvConfig):
         return {"robot": self.robot, "camera_mode": self.camera_mode, "split": self.split,
                 "image_size": tuple(self.image_size), "episode_length_s": self.episode_length_s}
 
-    def create_envs(self, n_envs: int, use_async_envs: bool = False) -> dict[str, dict[int, gym.vector.VectorEnv]]:
+    def sub_env_factories(self) -> dict[str, dict[int, partial]]:
+        """One sub-env factory per task of `task`, by suite and index in the suite: what `create_envs` batches."""
         log = self.episode_log or command_line_episode_log()
+        return {suite: {task_id: partial(make_tavis_env, task, episode_log=str(log) if log else None, suite=suite,
+                                         task_id=task_id, **self.gym_kwargs)
+                        for task_id, task in enumerate(tasks)}
+                for suite, tasks in expand_tasks(self.task).items()}
+
+    def create_envs(self, n_envs: int, use_async_envs: bool = False) -> dict[str, dict[int, gym.vector.VectorEnv]]:
         envs: dict[str, dict[int, gym.vector.VectorEnv]] = {}
-        for suite, tasks in expand_tasks(self.task).items():
+        for suite, factories in self.sub_env_factories().items():
             envs[suite] = {}
-            for task_id, task in enumerate(tasks):
-                factory = partial(make_tavis_env, task, episode_log=str(log) if log else None, suite=suite,
-                                  task_id=task_id, **self.gym_kwargs)
+            for task_id, factory in factories.items():
                 if use_async_envs and n_envs > 1:
-                    probe = factory.func(task, **self.gym_kwargs)  # spaces only: builds no simulator
+                    probe = factory.func(factory.args[0], **self.gym_kwargs)  # spaces only: builds no simulator
                     envs[suite][task_id] = LazyAsyncVectorEnv([factory] * n_envs, probe.observation_space,
                                                               probe.action_space, probe.metadata,
                                                               filmed_envs=self.filmed_envs,

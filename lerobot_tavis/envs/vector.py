@@ -17,13 +17,14 @@ envs. This module gives the same two behaviours from classes that import only gy
   also asks every sub-env for its `task_description` at each step, a round trip through all the workers (4.4 ms per
   step for 32 envs, one H100 machine); a prompt changes only at a reset, so it is asked once per reset.
   `worker_niceness` lowers the workers' CPU priority (added to their niceness, as `nice`), so that the process that
-  runs the policy is not delayed by them when the cores are contended.
+  runs the policy is not delayed by them when the cores are contended. `retarget` gives started workers other
+  sub-envs (another task or split, same spaces) without starting new processes.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import gymnasium as gym
@@ -64,20 +65,44 @@ class Unfilmed(gym.Wrapper):
 @dataclass(frozen=True)
 class Frozen:
     """A sub-env factory whose env freezes after its episode (picklable by reference to this module); an env not
-    `filmed` renders no frame. `niceness` is added to the niceness (as `nice`) of any process that calls it other
-    than `creator_pid`, the one that built it: gymnasium's AsyncVectorEnv also calls its first factory there, for the
-    spaces, and that process must keep its priority."""
+    `filmed` renders no frame."""
 
     make: Callable[[], gym.Env]
     filmed: bool = True
+
+    def __call__(self) -> gym.Env:
+        env = FreezeAfterEpisodeEnd(self.make())
+        return env if self.filmed else Unfilmed(env)
+
+
+class Retargetable(gym.Wrapper):
+    """The sub-env an async worker process holds: `retarget(factories)` closes the env it wraps and builds
+    `factories[index]()` in its place, in the same process."""
+
+    def __init__(self, factories: Sequence[Callable[[], gym.Env]], index: int):
+        super().__init__(factories[index]())
+        self.index = index
+
+    def retarget(self, factories: Sequence[Callable[[], gym.Env]]) -> None:
+        self.env.close()
+        self.env = factories[self.index]()
+
+
+@dataclass(frozen=True)
+class WorkerEnv:
+    """Builds sub-env `index` of `factories` as a `Retargetable`, first adding `niceness` to the niceness (as `nice`)
+    of any process that calls it other than `creator_pid`, the one that built it: gymnasium's AsyncVectorEnv also
+    calls its first factory there, for the spaces, and that process must keep its priority."""
+
+    factories: tuple[Frozen, ...]
+    index: int
     niceness: int = 0
     creator_pid: int = field(default_factory=os.getpid)
 
     def __call__(self) -> gym.Env:
         if self.niceness and os.getpid() != self.creator_pid:
             os.nice(self.niceness)
-        env = FreezeAfterEpisodeEnd(self.make())
-        return env if self.filmed else Unfilmed(env)
+        return Retargetable(self.factories, self.index)
 
 
 class LazyAsyncVectorEnv:
@@ -88,15 +113,28 @@ class LazyAsyncVectorEnv:
 
     def __init__(self, factories: list[Callable[[], gym.Env]], observation_space: gym.Space,
                  action_space: gym.Space, metadata: dict, filmed_envs: int = 10, worker_niceness: int = 0):
-        self._factories = [Frozen(factory, filmed=index < filmed_envs, niceness=worker_niceness)
-                           for index, factory in enumerate(factories)]
-        self._filmed_envs = filmed_envs
+        self._worker_niceness = worker_niceness
         self._env: gym.vector.AsyncVectorEnv | None = None
-        self._task_descriptions: tuple[str, ...] | None = None  # the sub-envs' prompts since the last reset
+        self._set_factories(factories, filmed_envs)
         self.num_envs = len(factories)
         self.observation_space = self.single_observation_space = observation_space
         self.action_space = self.single_action_space = action_space
         self.metadata = metadata
+
+    def _set_factories(self, factories: list[Callable[[], gym.Env]], filmed_envs: int) -> None:
+        self._frozen = tuple(Frozen(factory, filmed=index < filmed_envs) for index, factory in enumerate(factories))
+        self._filmed_envs = filmed_envs
+        self._task_descriptions: tuple[str, ...] | None = None  # the sub-envs' prompts since the last reset
+
+    def retarget(self, factories: list[Callable[[], gym.Env]], filmed_envs: int) -> None:
+        """Serve the sub-envs of `factories` (as many as now, with the same spaces: another task or split) from the
+        next reset on. Started workers close their sub-env and build the new one in the same process, so its
+        imports and its GL context are not paid again; only the first `filmed_envs` of them draw frames."""
+        if len(factories) != self.num_envs:
+            raise ValueError(f"retarget: {len(factories)} sub-env factories for a batch of {self.num_envs}")
+        self._set_factories(factories, filmed_envs)
+        if self._env is not None:
+            self._env.call("retarget", self._frozen)
 
     @property
     def unwrapped(self) -> LazyAsyncVectorEnv:
@@ -104,7 +142,8 @@ class LazyAsyncVectorEnv:
 
     def _started(self) -> gym.vector.AsyncVectorEnv:
         if self._env is None:
-            self._env = gym.vector.AsyncVectorEnv(self._factories, context="forkserver", shared_memory=True,
+            workers = [WorkerEnv(self._frozen, index, self._worker_niceness) for index in range(self.num_envs)]
+            self._env = gym.vector.AsyncVectorEnv(workers, context="forkserver", shared_memory=True,
                                                   autoreset_mode=gym.vector.AutoresetMode.NEXT_STEP)
         return self._env
 

@@ -13,6 +13,8 @@ hidden folder `.<cell>.chunks/` (episode log and a `done` record), so a killed r
 - Policies run as lerobot-eval runs (`lerobot_run.evaluate`: LeRobot's env, policy, processors and
   `eval_policy_all`), each chunk in a scratch folder; the first chunk of each task films its first
   `film_episodes` episodes, the other chunks film none (lerobot-eval films 10 and holds their frames in memory).
+  A worker keeps its env worker processes from one chunk to the next and builds the next chunk's task and split in
+  them (`lerobot_run.evaluate(keep_workers=True)`): a new episode starts from its seed either way.
 """
 
 from __future__ import annotations
@@ -184,7 +186,7 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
                              worker_niceness=ENV_WORKER_NICENESS if cfg.device != "cpu" else 0)
         batches = EvalConfig(n_episodes=chunk.n, batch_size=batch, use_async_envs=batch > 1)
         evaluate(pipeline_config(env=env, eval=batches, policy=policy, output_dir=out, seed=chunk.first_seed,
-                                 job_name=f"tavis_{chunk.task}_{chunk.split}"))
+                                 job_name=f"tavis_{chunk.task}_{chunk.split}"), keep_workers=True)
         task_metrics = json.loads((out / EVAL_INFO_NAME).read_text())["per_task"][0]["metrics"]
         lines = sorted((json.loads(line) | {"task_id": chunk.task_id}  # the run saw a one-task suite
                         for line in (out / EPISODE_LOG_NAME).read_text().splitlines()),
@@ -206,8 +208,12 @@ def _share_cores(jobs: int) -> None:
 
 
 def _close_envs() -> None:
+    """Close this process's kept envs: the demonstrators' scene, a policy job's env workers."""
+    from lerobot_tavis.eval.lerobot_run import close_kept_envs
+
     while _ENVS:
         _ENVS.popitem()[1].close()
+    close_kept_envs()
 
 
 def _done_path(work: Path, chunk: Chunk) -> Path:

@@ -9,18 +9,24 @@ the sub-envs that draw frames (`TavisEnvConfig.filmed_envs`); it writes the same
 `filmed_envs=0` no frame is rendered for a video at all.
 
 Its rollout converts each step's camera images from uint8 to float on the device instead of the CPU
-(`images_converted_on`): the same operations, in the same order, as LeRobot's own conversion.
+(`images_converted_on`): the same operations, in the same order, as LeRobot's own conversion. A process that runs
+one task after another (`tavis eval --policy`'s jobs) can keep its env workers between runs (`keep_workers`): the
+next run's task and split are built in the same worker processes.
 """
 
 from __future__ import annotations
 
+import atexit
 import json
 import logging
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
 from lerobot_tavis.atomic import write_text
+from lerobot_tavis.envs.vector import LazyAsyncVectorEnv
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
+
+_KEPT: dict[tuple, LazyAsyncVectorEnv] = {}  # this process's kept one-task async batch, by what fixes its workers
 
 
 def pipeline_config(**fields):
@@ -90,11 +96,64 @@ def images_converted_on(device):
         lerobot_eval.preprocess_observation = lerobots
 
 
-def evaluate(cfg) -> None:
+def close_kept_envs() -> None:
+    """Stop the env workers this process kept for a next run."""
+    while _KEPT:
+        _KEPT.popitem()[1].close()
+
+
+atexit.register(close_kept_envs)
+
+
+def _env_batches(cfg, keep_workers: bool) -> tuple[dict, bool]:
+    """make_env's batches for `cfg`, and whether they are kept for a next run. With `keep_workers`, a one-task async
+    batch stays started after the run, and the next run with the same robot, camera mode, image size, episode length,
+    batch size and worker niceness retargets its workers to its own task and split instead of starting new ones:
+    32 env workers with three cameras took 25-35 s to start beside two other jobs' on the 16-core GPU machine, their
+    GPU idle meanwhile (docs/benchmarks.md)."""
+    from lerobot.envs import make_env
+
+    env = cfg.env
+    key = (env.robot, env.camera_mode, tuple(env.image_size), env.episode_length_s, env.worker_niceness,
+           cfg.eval.batch_size)
+    factories = [(suite, task_id, factory)
+                 for suite, by_id in env.sub_env_factories().items() for task_id, factory in by_id.items()]
+    if keep_workers and key in _KEPT and len(factories) == 1:
+        suite, task_id, factory = factories[0]
+        _KEPT[key].retarget([factory] * cfg.eval.batch_size, env.filmed_envs)
+        return {suite: {task_id: _Lent(_KEPT[key])}}, True
+    close_kept_envs()
+    envs = make_env(env, n_envs=cfg.eval.batch_size, use_async_envs=cfg.eval.use_async_envs,
+                    trust_remote_code=cfg.trust_remote_code)
+    batches = [(suite, task_id, batch) for suite, by_id in envs.items() for task_id, batch in by_id.items()]
+    if keep_workers and len(batches) == 1 and isinstance(batches[0][2], LazyAsyncVectorEnv):
+        suite, task_id, batch = batches[0]
+        _KEPT[key] = batch
+        return {suite: {task_id: _Lent(batch)}}, True
+    return envs, False
+
+
+class _Lent:
+    """A kept batch as one run sees it: everything but `close`, which LeRobot's `eval_policy_all` calls after each
+    task, and which here leaves the workers started for the next run."""
+
+    def __init__(self, batch: LazyAsyncVectorEnv):
+        self._batch = batch
+
+    def __getattr__(self, name: str):
+        return getattr(self._batch, name)
+
+    def close(self) -> None:
+        return None
+
+
+def evaluate(cfg, keep_workers: bool = False) -> None:
     """Run the evaluation `cfg` (a LeRobot `EvalPipelineConfig` of the tavis env), filming the first
-    `cfg.env.filmed_envs` episodes of each task into `<output_dir>/videos/`; write `<output_dir>/eval_info.json`."""
+    `cfg.env.filmed_envs` episodes of each task into `<output_dir>/videos/`; write `<output_dir>/eval_info.json`.
+    With `keep_workers` a one-task async batch's workers outlive the run, for this process's next one
+    (`close_kept_envs` stops them; they also stop when the process exits)."""
     import torch
-    from lerobot.envs import close_envs, make_env, make_env_pre_post_processors
+    from lerobot.envs import close_envs, make_env_pre_post_processors
     from lerobot.policies import make_policy, make_pre_post_processors
     from lerobot.scripts.lerobot_eval import eval_policy_all
     from lerobot.utils.device_utils import get_safe_torch_device
@@ -104,8 +163,8 @@ def evaluate(cfg) -> None:
     torch.backends.cudnn.benchmark = True  # as eval_main sets them, so that results equal a lerobot-eval run's
     torch.backends.cuda.matmul.allow_tf32 = True
     set_seed(cfg.seed)
-    envs = make_env(cfg.env, n_envs=cfg.eval.batch_size, use_async_envs=cfg.eval.use_async_envs,
-                    trust_remote_code=cfg.trust_remote_code)
+    envs, kept = _env_batches(cfg, keep_workers)
+    finished = False
     try:
         policy = make_policy(cfg=cfg.policy, env_cfg=cfg.env, rename_map=cfg.rename_map)
         policy.eval()
@@ -122,6 +181,10 @@ def evaluate(cfg) -> None:
                                    max_episodes_rendered=cfg.env.filmed_envs,
                                    videos_dir=Path(cfg.output_dir) / "videos",
                                    start_seed=cfg.seed, max_parallel_tasks=cfg.env.max_parallel_tasks)
+        finished = True
     finally:
-        close_envs(envs)
+        if not kept:
+            close_envs(envs)
+        elif not finished:  # workers stopped mid-rollout are not reused
+            close_kept_envs()
     write_text(Path(cfg.output_dir) / EVAL_INFO_NAME, json.dumps(info, indent=2))

@@ -146,6 +146,34 @@ def test_async_workers_run_at_the_given_niceness_above_this_process(worker_nicen
     assert workers == [own_niceness + worker_niceness] * 2
 
 
+def test_retargeted_workers_build_the_new_task_in_the_same_processes():
+    """`retarget` swaps every started worker's sub-env for the new task's, in the same process and at the same
+    niceness; its episodes are those of a new batch of that task."""
+    fresh = TavisEnvConfig(task="conditional_pick", image_size=(24, 32)).create_envs(2, True)["tavis_head"][0]
+    expected, _ = fresh.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+    fresh.close()
+    vec = TavisEnvConfig(task="wait_then_act", image_size=(24, 32), worker_niceness=3,
+                         filmed_envs=2).create_envs(2, True)["tavis_head"][0]
+    try:
+        vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+        workers = [process.pid for process in vec._started().processes]
+        niceness = [os.getpriority(os.PRIO_PROCESS, pid) for pid in workers]
+        factory = TavisEnvConfig(task="conditional_pick", image_size=(24, 32)).sub_env_factories()["tavis_head"][0]
+        with pytest.raises(ValueError, match="3 sub-env factories for a batch of 2"):
+            vec.retarget([factory] * 3, filmed_envs=1)
+        vec.retarget([factory] * 2, filmed_envs=1)
+        observation, _ = vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+        assert [process.pid for process in vec._started().processes] == workers
+        assert [os.getpriority(os.PRIO_PROCESS, pid) for pid in workers] == niceness
+        assert vec.call("task") == ("conditional_pick", "conditional_pick")
+        assert len(vec.call("render")) == 1 and vec._started().call("render")[1] is None
+        for camera, images in expected["pixels"].items():
+            assert np.array_equal(observation["pixels"][camera], images), camera
+        assert np.array_equal(observation["agent_pos"], expected["agent_pos"])
+    finally:
+        vec.close()
+
+
 def test_a_negative_filmed_env_count_is_refused():
     with pytest.raises(ValueError, match="filmed_envs must be an integer >= 0"):
         TavisEnvConfig(filmed_envs=-1)

@@ -208,6 +208,51 @@ def test_filming_changes_no_result_and_zero_films_nothing(tmp_path):
     assert not (tmp_path / "none" / "tavis_hands__id" / "videos").exists()
 
 
+def _policy_run(checkpoint, out, task, keep_workers):
+    """One lerobot-eval run of `task` (2 episodes in one async batch of 2, the first filmed), as a policy chunk."""
+    from types import SimpleNamespace
+
+    from lerobot.configs.default import EvalConfig
+
+    from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.cell_runs import policy_config
+    from lerobot_tavis.eval.lerobot_run import evaluate, pipeline_config
+
+    policy = policy_config(SimpleNamespace(policy_path=str(checkpoint), device="cpu",
+                                           policy_options=(("num_inference_steps", 1),)))
+    env = TavisEnvConfig(task=task, image_size=(32, 48), episode_length_s=0.5, filmed_envs=1,
+                         episode_log=str(out / "episodes.jsonl"))
+    evaluate(pipeline_config(env=env, eval=EvalConfig(n_episodes=2, batch_size=2, use_async_envs=True),
+                             policy=policy, output_dir=out, seed=1000), keep_workers=keep_workers)
+    info = json.loads((out / "eval_info.json").read_text())["per_task"][0]["metrics"]
+    records = sorted((out / "episodes.jsonl").read_text().splitlines())  # logged in the order episodes end
+    return records, [info[key] for key in ("successes", "sum_rewards", "max_rewards")]
+
+
+def test_kept_env_workers_play_the_next_task_as_new_ones_would(tmp_path):
+    """A job's env workers outlive its run and build the next run's task in the same processes: same results."""
+    from lerobot_tavis.eval import lerobot_run
+
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    try:
+        _policy_run(tmp_path / "ckpt", tmp_path / "first", "wait_then_act", keep_workers=True)
+        (batch,) = lerobot_run._KEPT.values()
+        workers = [process.pid for process in batch._started().processes]
+        kept = _policy_run(tmp_path / "ckpt", tmp_path / "kept", "conditional_pick", keep_workers=True)
+        assert list(lerobot_run._KEPT.values()) == [batch]
+        assert [process.pid for process in batch._started().processes] == workers
+        assert batch.call("task") == ("conditional_pick", "conditional_pick")
+        assert (tmp_path / "kept" / "videos").is_dir()
+    finally:
+        lerobot_run.close_kept_envs()
+    assert not lerobot_run._KEPT
+    fresh = _policy_run(tmp_path / "ckpt", tmp_path / "fresh", "conditional_pick", keep_workers=False)
+    assert not lerobot_run._KEPT
+    assert kept == fresh
+    assert [(json.loads(line)["task"], json.loads(line)["seed"]) for line in kept[0]] == [
+        ("conditional_pick", 1000), ("conditional_pick", 1001)]
+
+
 def test_a_negative_film_count_is_refused(tmp_path):
     with pytest.raises(FieldError, match="film_episodes"):
         ProtocolConfig(out_dir=tmp_path, expert=True, film_episodes=-1)
