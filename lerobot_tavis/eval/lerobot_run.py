@@ -22,6 +22,8 @@ import logging
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
+import numpy as np
+
 from lerobot_tavis.atomic import write_text
 from lerobot_tavis.envs.vector import LazyAsyncVectorEnv
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
@@ -65,13 +67,16 @@ def images_converted_on(device):
 
     LeRobot converts them on the CPU, in the process that also runs the policy, and its device processor then
     copies four times the bytes to the GPU: 13 ms a step for the 96 images of 32 envs at 240x320 with three
-    cameras, on the one-GPU machine (docs/benchmarks.md), while that job's envs wait. The result is the same tensors
-    (an exact conversion: uint8 to float32, then division by 255), already on the policy's device."""
+    cameras, on the one-GPU machine (docs/benchmarks.md), while that job's envs wait. Here each pixel value looks up
+    its float in a table that LeRobot's CPU conversion computed (a GPU divides by 255 as a multiplication by its
+    reciprocal, which rounds half of the 256 values differently), so the tensors are the same, already on `device`."""
     import torch
     from lerobot.scripts import lerobot_eval
     from lerobot.utils.constants import OBS_IMAGES
 
     lerobots = lerobot_eval.preprocess_observation
+    levels = lerobots({"pixels": {"all": np.arange(256, dtype=np.uint8).reshape(1, 16, 16, 1)}})
+    floats = levels[f"{OBS_IMAGES}.all"].flatten().to(device)  # floats[v]: LeRobot's float for pixel value v
 
     def to_float(image):
         batch = torch.from_numpy(image).to(device)
@@ -79,7 +84,7 @@ def images_converted_on(device):
             batch = batch.unsqueeze(0)
         if batch.dtype != torch.uint8 or batch.shape[-1] >= min(batch.shape[1:3]):
             raise ValueError(f"camera images must be uint8, channel last; got {batch.dtype} {tuple(batch.shape)}")
-        return batch.permute(0, 3, 1, 2).contiguous().float().div_(255)
+        return floats[batch.permute(0, 3, 1, 2).int()]
 
     def preprocess(observations: dict) -> dict:
         pixels = observations.get("pixels")
