@@ -9,7 +9,7 @@ the sub-envs that draw frames (`TavisEnvConfig.filmed_envs`); it writes the same
 `filmed_envs=0` no frame is rendered for a video at all.
 
 Its rollout converts each step's camera images from uint8 to float on the device instead of the CPU
-(`images_converted_on`): the same operations, in the same order, as LeRobot's own conversion. A process that runs
+(`images_converted_on`), to the same values as LeRobot's own conversion. A process that runs
 one task after another (`tavis eval --policy`'s jobs) can keep its env workers between runs (`keep_workers`): the
 next run's task and split are built in the same worker processes.
 """
@@ -114,8 +114,8 @@ def _env_batches(cfg, keep_workers: bool) -> tuple[dict, bool]:
     """make_env's batches for `cfg`, and whether they are kept for a next run. With `keep_workers`, a one-task async
     batch stays started after the run, and the next run with the same robot, camera mode, image size, episode length,
     batch size and worker niceness retargets its workers to its own task and split instead of starting new ones:
-    32 env workers with three cameras took 25-35 s to start beside two other jobs' on the 16-core GPU machine, their
-    GPU idle meanwhile (docs/benchmarks.md)."""
+    32 env workers with three cameras took 25-33 s to start beside two other jobs' on a 16-CPU share of a GPU
+    machine, the GPU idle meanwhile (docs/benchmarks.md)."""
     from lerobot.envs import make_env
 
     env = cfg.env
