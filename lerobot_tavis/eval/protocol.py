@@ -12,6 +12,7 @@ kill and each cell is moved into place when complete, so a re-run skips finished
 from __future__ import annotations
 
 import json
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -184,5 +185,9 @@ def run_protocol(cfg: ProtocolConfig) -> list[Path]:
         print(f"{cell.name}: done already, skipped")
     if cfg.policy_path is not None:
         policy_config(cfg)  # a bad --policy-option fails here, before any job starts
+    started = time.perf_counter()
     run_cells(cfg, pending)
-    return write_report(cfg.out_dir)
+    played = time.perf_counter()
+    written = write_report(cfg.out_dir)
+    print(f"episodes played in {played - started:.1f} s, report written in {time.perf_counter() - played:.1f} s")
+    return written

@@ -3,6 +3,7 @@
 import json
 import logging
 import os
+import re
 import subprocess
 import sys
 
@@ -30,7 +31,9 @@ def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
     assert sum(c["n"] for c in results["cells"]) == 6
     before = (cell / "eval_info.json").stat().st_mtime_ns
     run_protocol(cfg)
-    assert "tavis_hands__id: done already, skipped" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "tavis_hands__id: done already, skipped" in out
+    assert re.search(r"episodes played in \d+\.\d s, report written in \d+\.\d s", out)
     assert (cell / "eval_info.json").stat().st_mtime_ns == before
     assert not list(tmp_path.glob(".*partial*"))
 
