@@ -68,8 +68,8 @@ def images_converted_on(device):
     LeRobot converts them on the CPU, in the process that also runs the policy, and its device processor then
     copies four times the bytes to the GPU: 13 ms a step for the 96 images of 32 envs at 240x320 with three
     cameras, on the one-GPU machine (docs/benchmarks.md), while that job's envs wait. Here each pixel value looks up
-    its float in a table that LeRobot's CPU conversion computed (a GPU divides by 255 as a multiplication by its
-    reciprocal, which rounds half of the 256 values differently), so the tensors are the same, already on `device`."""
+    its float in a table that LeRobot's CPU conversion computed (a division by 255 on the GPU rounds 126 of the 256
+    values differently, like a multiplication by the reciprocal), so the tensors are the same, already on `device`."""
     import torch
     from lerobot.scripts import lerobot_eval
     from lerobot.utils.constants import OBS_IMAGES
