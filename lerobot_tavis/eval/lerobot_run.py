@@ -121,12 +121,13 @@ def _env_batches(cfg, keep_workers: bool) -> tuple[dict, bool]:
     env = cfg.env
     key = (env.robot, env.camera_mode, tuple(env.image_size), env.episode_length_s, env.worker_niceness,
            cfg.eval.batch_size)
-    factories = [(suite, task_id, factory)
-                 for suite, by_id in env.sub_env_factories().items() for task_id, factory in by_id.items()]
-    if keep_workers and key in _KEPT and len(factories) == 1:
-        suite, task_id, factory = factories[0]
-        _KEPT[key].retarget([factory] * cfg.eval.batch_size, env.filmed_envs)
-        return {suite: {task_id: _Lent(_KEPT[key])}}, True
+    if keep_workers and key in _KEPT:
+        factories = [(suite, task_id, factory)
+                     for suite, by_id in env.sub_env_factories().items() for task_id, factory in by_id.items()]
+        if len(factories) == 1:
+            suite, task_id, factory = factories[0]
+            _KEPT[key].retarget([factory] * cfg.eval.batch_size, env.filmed_envs)
+            return {suite: {task_id: _Lent(_KEPT[key])}}, True
     close_kept_envs()
     envs = make_env(env, n_envs=cfg.eval.batch_size, use_async_envs=cfg.eval.use_async_envs,
                     trust_remote_code=cfg.trust_remote_code)
