@@ -16,9 +16,9 @@ next run's task and split are built in the same worker processes.
 
 from __future__ import annotations
 
-import atexit
 import json
 import logging
+import multiprocessing.util
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
@@ -107,7 +107,9 @@ def close_kept_envs() -> None:
         _KEPT.popitem()[1].close()
 
 
-atexit.register(close_kept_envs)
+# At exit, before multiprocessing terminates this process's daemonic children (the env workers): an atexit hook
+# ran after that in pool worker processes, and its close found the workers' pipes broken.
+multiprocessing.util.Finalize(None, close_kept_envs, exitpriority=10)
 
 
 def _env_batches(cfg, keep_workers: bool) -> tuple[dict, bool]:

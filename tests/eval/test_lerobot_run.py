@@ -1,3 +1,7 @@
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import torch
@@ -39,3 +43,35 @@ def test_one_env_gets_a_batch_dimension_and_bad_images_are_refused():
         with pytest.raises(ValueError, match="uint8, channel last"):
             lerobot_eval.preprocess_observation({"pixels": {"head": np.zeros((1, 12, 16, 3), np.float32)}})
     assert lerobot_eval.preprocess_observation is preprocess_observation
+
+
+KEEP_AND_EXIT = """
+import multiprocessing, sys
+from lerobot_tavis.envs.config import TavisEnvConfig
+from lerobot_tavis.eval import lerobot_run
+
+def keep_a_batch():
+    batch = TavisEnvConfig(task="conditional_pick", image_size=(24, 32)).create_envs(2, True)["tavis_head"][0]
+    batch.reset(seed=0)
+    lerobot_run._KEPT["kept"] = batch  # as a policy job leaves it between chunks
+    print("workers", *(process.pid for process in batch._started().processes), file=sys.stderr)
+
+if __name__ == "__main__":
+    job = multiprocessing.get_context("spawn").Process(target=keep_a_batch)
+    job.start()
+    job.join()
+    sys.exit(job.exitcode)
+"""
+
+
+def test_a_job_that_exits_closes_its_kept_env_workers_cleanly(tmp_path):
+    """A policy job's kept env workers are closed before multiprocessing terminates them at the job's exit (a
+    close after that wrote a BrokenPipeError traceback per job)."""
+    script = tmp_path / "keep_and_exit.py"
+    script.write_text(KEEP_AND_EXIT)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "MUJOCO_GL": "egl"})
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, done.stderr
+    workers = [int(pid) for line in done.stderr.splitlines() if line.startswith("workers ") for pid in line.split()[1:]]
+    assert len(workers) == 2 and not any(os.path.exists(f"/proc/{pid}") for pid in workers)
