@@ -9,6 +9,7 @@ import signal
 import sys
 
 _PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
+MAX_NICENESS = 19  # Linux's lowest CPU priority; a process's niceness stops there
 
 
 def die_with_parent(parent_pid: int) -> None:

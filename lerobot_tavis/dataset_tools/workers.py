@@ -19,7 +19,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 
 from lerobot_tavis import checks
 from lerobot_tavis.errors import TavisError
-from lerobot_tavis.process import die_with_parent
+from lerobot_tavis.process import MAX_NICENESS, die_with_parent
 
 BACKENDS = ("local", "ray")
 
@@ -92,13 +92,22 @@ def usable_cores() -> int:
     return len(os.sched_getaffinity(0))
 
 
-def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0):
+def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0, niceness: int = 0):
     """The pool for `backend`: local spawned processes (MuJoCo's EGL contexts and torch do not survive a fork), or
-    inline for one worker; Ray ignores `workers` and runs what the cluster's resources allow."""
+    inline for one worker; Ray ignores `workers` and runs what the cluster's resources allow. Local worker
+    processes add `niceness` to their niceness (as `nice`: 19 runs them only on cores nothing else wants); the
+    calling process and Ray's workers keep theirs."""
     checks.integer("workers", workers, 1)
+    checks.integer("niceness", niceness, 0, MAX_NICENESS)
     if checks.choice("backend", backend, BACKENDS) == "ray":
         return RayExecutor(gpus=gpus_per_job)
     if workers == 1:
         return InlineExecutor()
-    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=die_with_parent,
-                               initargs=(os.getpid(),))
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_start_local_worker, initargs=(os.getpid(), niceness))
+
+
+def _start_local_worker(parent_pid: int, niceness: int) -> None:
+    die_with_parent(parent_pid)
+    if niceness:
+        os.nice(niceness)

@@ -32,8 +32,8 @@ from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_info
 from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split
 from lerobot_tavis.envs.vector import Frozen, LazyAsyncVectorEnv
 from lerobot_tavis.errors import FieldError
+from lerobot_tavis.process import MAX_NICENESS
 
-MAX_NICENESS = 19  # Linux's lowest CPU priority; a process's niceness stops there
 
 
 @EnvConfig.register_subclass("tavis")

@@ -14,7 +14,9 @@ hidden folder `.<cell>.chunks/` (episode log and a `done` record), so a killed r
   `eval_policy_all`), each chunk in a scratch folder; the first chunk of each task films its first
   `film_episodes` episodes, the other chunks film none (lerobot-eval films 10 and holds their frames in memory).
   A worker keeps its env worker processes from one chunk to the next and builds the next chunk's task and split in
-  them (`lerobot_run.evaluate(keep_workers=True)`): a new episode starts from its seed either way.
+  them (`lerobot_run.evaluate(keep_workers=True)`): a new episode starts from its seed either way. A filmed chunk's
+  videos are annotated (`eval.annotate`) by low-priority processes of this machine while the other chunks play,
+  and its cell is assembled with those copies, so the report has none left to make.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.dataset_tools.workers import executor, usable_cores
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import InputError, PathNotFoundError
+from lerobot_tavis.eval.annotate import ANNOTATED_DIR, Annotator, episode_index
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
 
@@ -80,15 +83,18 @@ def run_cells(cfg, cells: Sequence) -> None:
     total = sum(chunk.n for cell_chunks in chunks.values() for chunk in cell_chunks)
     started = time.perf_counter()
     desc = "demonstrators" if cfg.policy_path is None else "policy"
-    with tqdm(total=total, initial=total - sum(c.n for c in todo), desc=desc, unit="ep") as bar:
+    with (tqdm(total=total, initial=total - sum(c.n for c in todo), desc=desc, unit="ep") as bar,
+          Annotator(usable_cores()) as annotator):
         for name in [name for name, left in waiting.items() if not left]:  # finished before a kill
             _assemble(cfg, name, chunks[name], work[name], started)
         for result in _completed(cfg, play, [(cfg, chunk) for chunk in todo]):
             chunk = result.chunk
             _keep_chunk(work[chunk.cell_name], result)
+            _annotate_chunk(annotator, work[chunk.cell_name], result)
             bar.update(chunk.n)
             waiting[chunk.cell_name].remove(chunk)
             if not waiting[chunk.cell_name]:
+                annotator.write(chunk.cell_name)
                 _assemble(cfg, chunk.cell_name, chunks[chunk.cell_name], work[chunk.cell_name], started)
 
 
@@ -232,6 +238,19 @@ def _keep_chunk(work: Path, result: ChunkResult) -> None:
     write_text(_done_path(work, chunk), json.dumps(result.metrics))
 
 
+def _annotate_chunk(annotator: Annotator, work: Path, result: ChunkResult) -> None:
+    """Have the chunk's videos annotated beside them (`<stem>.videos_annotated/`) while other chunks play: the
+    report would otherwise annotate a protocol's 60 videos after its last rollout (45 s on the one-H100 machine,
+    docs/benchmarks.md). Video i is the episode of the chunk's seed first_seed + i."""
+    chunk = result.chunk
+    records = {record["seed"]: record for record in map(json.loads, result.log_text.splitlines())}
+    for name in sorted(result.videos):
+        video = work / f"{chunk.stem}.videos" / name
+        record = records.get(chunk.first_seed + episode_index(video))
+        if record is not None:  # else an episode LeRobot filmed but did not score
+            annotator.submit(chunk.cell_name, video, work / f"{chunk.stem}.{ANNOTATED_DIR}" / name, record)
+
+
 def _assemble(cfg, cell_name: str, chunks: list[Chunk], work: Path, started: float) -> None:
     """Write the cell from its chunks, in task then seed order, and drop the chunks."""
     suite = chunks[0].suite
@@ -245,9 +264,10 @@ def _assemble(cfg, cell_name: str, chunks: list[Chunk], work: Path, started: flo
                 task = per_task.setdefault(chunk.task_id, {key: [] for key in METRICS})
                 for key in METRICS:
                     task[key].extend(metrics[key])
-                videos = work / f"{chunk.stem}.videos"
-                if videos.is_dir():
-                    shutil.copytree(videos, partial / "videos" / f"{suite}_{chunk.task_id}")
+                for kind in ("videos", ANNOTATED_DIR):
+                    videos = work / f"{chunk.stem}.{kind}"
+                    if videos.is_dir():  # copied with their times: an annotated copy stays newer than its video
+                        shutil.copytree(videos, partial / kind / f"{suite}_{chunk.task_id}")
         tasks = [{"task_group": suite, "task_id": task_id,
                   "metrics": {**metrics, "video_paths": sorted(
                       str(p.relative_to(partial)) for p in (partial / "videos" / f"{suite}_{task_id}").glob("*.mp4"))}}

@@ -1,9 +1,11 @@
 """`tavis report` draws each episode's GALT events onto a copy of the videos lerobot-eval wrote."""
 
 import json
+import os
 
 import numpy as np
 
+from lerobot_tavis.eval.annotate import Annotator
 from lerobot_tavis.eval.report import write_report
 from lerobot_tavis.media import iter_mp4, write_mp4
 from lerobot_tavis.overlay import EVENT_COLOURS, Caption, band_height, compose
@@ -70,3 +72,30 @@ def test_annotated_videos_do_not_depend_on_the_number_of_workers(tmp_path):
     assert [len(video) for video in frames[1]] == [41, 61]
     assert all(np.array_equal(one, two) for one, two in zip(frames[1], frames[2], strict=True))
     assert not list(tmp_path.rglob("*.partial*"))
+
+
+def test_a_copy_newer_than_its_video_is_kept_and_an_older_one_redone(tmp_path):
+    _filmed_evaluation(tmp_path)
+    first = [path for path in write_report(tmp_path, workers=1) if path.suffix == ".mp4"]
+    assert len(first) == 2
+    assert not [path for path in write_report(tmp_path, workers=1) if path.suffix == ".mp4"]
+    video = tmp_path / "videos" / "tavis_head_0" / "eval_episode_1.mp4"
+    copy = tmp_path / "videos_annotated" / "tavis_head_0" / "eval_episode_1.mp4"
+    later = copy.stat().st_mtime_ns + 10**9
+    os.utime(video, ns=(later, later))  # the video filmed again after its copy was made
+    assert [path for path in write_report(tmp_path, workers=1) if path.suffix == ".mp4"] == [copy]
+
+
+def test_the_annotator_writes_each_group_when_asked_from_worker_processes(tmp_path):
+    _filmed_evaluation(tmp_path)
+    videos = tmp_path / "videos" / "tavis_head_0"
+    records = [json.loads(line) for line in (tmp_path / "episodes.jsonl").read_text().splitlines()]
+    with Annotator(workers=2) as annotator:
+        for ix, record in enumerate(records):
+            annotator.submit(f"group {ix}", videos / f"eval_episode_{ix}.mp4", tmp_path / f"copy_{ix}.mp4", record)
+        assert annotator.write("group 1") == [tmp_path / "copy_1.mp4"]
+        assert not (tmp_path / "copy_0.mp4").exists()
+        assert annotator.write("group 0") == [tmp_path / "copy_0.mp4"]
+    expected = [path for path in write_report(tmp_path, workers=1) if path.suffix == ".mp4"]
+    for ix, path in enumerate(expected):
+        assert np.array_equal(np.stack(list(iter_mp4(tmp_path / f"copy_{ix}.mp4"))), np.stack(list(iter_mp4(path))))

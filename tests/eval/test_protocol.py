@@ -13,7 +13,9 @@ from lerobot_tavis.cli import main
 from lerobot_tavis.eval import protocol
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import FieldError, InputError
-from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
+from lerobot_tavis.eval.cell_runs import run_cells
+from lerobot_tavis.eval.protocol import Cell, ProtocolConfig, run_protocol
+from lerobot_tavis.eval.report import write_report
 
 
 def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
@@ -295,3 +297,18 @@ def test_the_eval_config_of_a_checkpoint_does_not_warn_of_random_weights(caplog)
     assert cfg.policy.pretrained_path == "ckpt"
     with pytest.raises(ValueError, match="pretrained_path"):
         pipeline_config(env=TavisEnvConfig(), policy=DiffusionConfig(), job_name="probe")
+
+
+def test_a_policy_run_annotates_its_videos_while_it_plays(tmp_path):
+    """Each filmed chunk's videos are annotated as it finishes, so the cell holds its copies before any report."""
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_hands",), tasks=("peeking_box",), splits=("id",),
+                         n_episodes=2, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
+                         policy_options=(("num_inference_steps", 1),), workers=2, chunk_episodes=1, film_episodes=1)
+    run_cells(cfg, [Cell("tavis_hands", "id")])
+    cell = tmp_path / "eval" / "tavis_hands__id"
+    video = cell / "videos" / "tavis_hands_0" / "eval_episode_0.mp4"
+    copy = cell / "videos_annotated" / "tavis_hands_0" / "eval_episode_0.mp4"
+    assert copy.stat().st_mtime_ns > video.stat().st_mtime_ns
+    assert sorted(path.name for path in cell.rglob("*.mp4")) == ["eval_episode_0.mp4"] * 2
+    assert not [path for path in write_report(tmp_path / "eval") if path.suffix == ".mp4"]
