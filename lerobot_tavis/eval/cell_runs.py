@@ -122,7 +122,9 @@ def _completed(cfg, fn: Callable, jobs: list[tuple]) -> Iterator:
     with executor(cfg.workers, cfg.backend, gpus_per_job=cfg.gpus_per_job) as pool:
         futures = [pool.submit(fn, *job) for job in jobs]
         try:
-            for future in as_completed(futures):
+            for done, future in enumerate(as_completed(futures), 1):
+                if done == len(futures):  # the workers exit while the last result is handled (6 s for policy jobs)
+                    pool.shutdown(wait=False)
                 yield future.result()
         finally:
             pool.shutdown(wait=True, cancel_futures=True)

@@ -25,7 +25,7 @@ from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import (BENCHMARK_TASKS, PROTOCOL_SPLITS, SUITES, split_names, suite_tasks,
                                               task_info)
 from lerobot_tavis.errors import FieldError, InputError
-from lerobot_tavis.eval.cell_runs import played_tasks, policy_config, run_cells
+from lerobot_tavis.eval.cell_runs import played_tasks, run_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
 
 START_SEED = 1000
@@ -183,8 +183,9 @@ def run_protocol(cfg: ProtocolConfig) -> list[Path]:
             raise InputError(f"{info.parent} holds the tasks {[suite_tasks(cell.suite)[i] for i in held]}, not those "
                              "asked for: give another --out")
         print(f"{cell.name}: done already, skipped")
-    if cfg.policy_path is not None:
-        policy_config(cfg)  # a bad --policy-option fails here, before any job starts
+    # A bad --policy-option fails in the first job, when it reads the checkpoint's config: checking it here first
+    # would import LeRobot in this process too, which held back the start of every job by 27 s on the one-H100
+    # machine (docs/benchmarks.md).
     started = time.perf_counter()
     run_cells(cfg, pending)
     played = time.perf_counter()

@@ -129,12 +129,16 @@ def test_lerobot_options_pass_through_to_the_policy_and_the_env(tmp_path, monkey
         main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), "--policy-option", "steps"])
 
 
-def test_an_unknown_policy_option_names_the_field(tmp_path):
+@pytest.mark.parametrize("workers", [1, 2])
+def test_an_unknown_policy_option_names_the_field(tmp_path, workers):
+    """Refused by the first job to read the checkpoint's config, in this process or in a worker."""
     _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
     cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("id",), n_episodes=1,
-                         image_size=(32, 48), policy_path=str(tmp_path / "ckpt"), policy_options=(("denoise", 3),))
+                         image_size=(32, 48), policy_path=str(tmp_path / "ckpt"), policy_options=(("denoise", 3),),
+                         workers=workers)
     with pytest.raises(ValueError, match="--policy-option denoise: the diffusion policy has no such field"):
         run_protocol(cfg)
+    assert not any((tmp_path / "eval").iterdir())
 
 
 def test_a_fresh_tavis_eval_process_reads_the_checkpoints_policy_type(tmp_path):
