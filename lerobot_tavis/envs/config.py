@@ -35,7 +35,6 @@ from lerobot_tavis.errors import FieldError
 from lerobot_tavis.process import MAX_NICENESS
 
 
-
 @EnvConfig.register_subclass("tavis")
 @dataclass
 class TavisEnvConfig(EnvConfig):
