@@ -79,8 +79,8 @@ class TavisEnv(gym.Env):
     `info["conditions"]` holds the parts of the task's success rule (`Task.evaluate` less "success", which is
     `info["is_success"]`), e.g. `{"target_lifted": True, "target_slow": False, "target_height_m": 1.31, ...}`, and
     `info["reach"]` how far the episode has got toward a task's target so far (`lerobot_tavis.envs.reach`):
-    `{"closest_hand_m": 0.012, "target_moved_m": 0.25, "first_grasp_xy_m": 0.004}`, or None for a task without
-    one.
+    `{"closest_hand_m": 0.012, "closest_hand_other_m": 0.31, "target_moved_m": 0.25, "first_grasp_xy_m": 0.004}`,
+    or None for a task without one.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": physics.POLICY_HZ}
@@ -273,7 +273,8 @@ class TavisEnv(gym.Env):
         if not isinstance(self._facts, TargetFacts):
             return None
         sites = {side: arm.grasp_site for side, arm in sim.world.arms.items()}
-        return ReachTracker(sim.data, sim.model.body(self._facts.target).id, sites)
+        others = tuple(sim.model.body(name).id for name in self._facts.props if name != self._facts.target)
+        return ReachTracker(sim.data, sim.model.body(self._facts.target).id, sites, others)
 
     def _observe(self, sim: _Sim) -> dict:
         self._last_frames = sim.rig.render(sim.data)

@@ -1,7 +1,7 @@
-"""How far an episode got toward its target, to tell failures apart: a policy that never brought a hand to the
-target (searched in vain, or went for another object), one that reached it and never moved it (a missed or
-unclosed grasp), and one that moved it without succeeding (dropped, not lifted high enough); and how well placed
-its first grasp of the target was."""
+"""How far an episode got toward its target, to tell failures apart: a policy that brought a hand to another
+object and never to the target (it chose wrong), one that brought a hand to neither (searched in vain, or kept
+still), one that reached the target and never moved it (a missed or unclosed grasp), and one that moved it without
+succeeding (dropped, not lifted high enough); and how well placed its first grasp of the target was."""
 
 from __future__ import annotations
 
@@ -13,21 +13,24 @@ from lerobot_tavis.envs.tasks.base import MEASURE_DECIMALS
 
 REACHED_M = 0.05  # a hand's grasp site this near the target's origin got to it (the demonstrators' test too)
 MOVED_M = 0.02  # the target's origin this far from where the episode found it was moved by the robot
-FAILURE_STAGES = ("not_reached", "reached_not_moved", "moved_no_success")
+FAILURE_STAGES = ("reached_other", "not_reached", "reached_not_moved", "moved_no_success")
 
 
 class ReachTracker:
     """Over one episode of a task with a target body, world frame: the closest any hand's grasp site came to the
-    target's origin (m), the farthest that origin got from where it was at the first observation (m), and the
+    target's origin (m) and to the origin of any of the `other_bodies` (the scene's other props, m; None without
+    any), the farthest the target's origin got from where it was at the first observation (m), and the
     horizontal distance (m) from the target's origin to the grasp site of the first hand that closed its gripper
     within REACHED_M of it (None until one does; the demonstrators centre their pads on the object, so this is
     how far off a grasp was placed)."""
 
-    def __init__(self, data: mujoco.MjData, target_body: int, grasp_sites: dict[str, int]):
-        self._body, self._sites = target_body, grasp_sites
+    def __init__(self, data: mujoco.MjData, target_body: int, grasp_sites: dict[str, int],
+                 other_bodies: tuple[int, ...] = ()):
+        self._body, self._sites, self._others = target_body, grasp_sites, other_bodies
         self._start = data.xpos[target_body].copy()
         self._closed = dict.fromkeys(grasp_sites, False)
         self.closest_hand_m, self.target_moved_m = np.inf, 0.0
+        self.closest_hand_other_m = np.inf
         self.first_grasp_xy_m: float | None = None
         self._measure(data)
 
@@ -44,21 +47,35 @@ class ReachTracker:
             self._closed[arm.side] = closed
 
     def summary(self) -> dict[str, float | None]:
-        """`{"closest_hand_m", "target_moved_m", "first_grasp_xy_m"}`, to the millimetre as the success conditions
-        are."""
-        first = None if self.first_grasp_xy_m is None else round(self.first_grasp_xy_m, MEASURE_DECIMALS)
-        return {"closest_hand_m": round(self.closest_hand_m, MEASURE_DECIMALS),
-                "target_moved_m": round(self.target_moved_m, MEASURE_DECIMALS), "first_grasp_xy_m": first}
+        """`{"closest_hand_m", "closest_hand_other_m", "target_moved_m", "first_grasp_xy_m"}`, to the millimetre as
+        the success conditions are."""
+        return {"closest_hand_m": _millimetre(self.closest_hand_m),
+                "closest_hand_other_m": _millimetre(self.closest_hand_other_m) if self._others else None,
+                "target_moved_m": _millimetre(self.target_moved_m),
+                "first_grasp_xy_m": None if self.first_grasp_xy_m is None else _millimetre(self.first_grasp_xy_m)}
 
     def _measure(self, data: mujoco.MjData) -> None:
+        hands = data.site_xpos[list(self._sites.values())]
         target = data.xpos[self._body]
-        nearest = min(float(np.linalg.norm(data.site_xpos[site] - target)) for site in self._sites.values())
-        self.closest_hand_m = min(self.closest_hand_m, nearest)
+        self.closest_hand_m = min(self.closest_hand_m, _nearest(hands, target[None]))
+        if self._others:
+            self.closest_hand_other_m = min(self.closest_hand_other_m, _nearest(hands, data.xpos[list(self._others)]))
         self.target_moved_m = max(self.target_moved_m, float(np.linalg.norm(target - self._start)))
 
 
+def _nearest(hands: np.ndarray, bodies: np.ndarray) -> float:
+    """The smallest distance between any of the points `hands` (n, 3) and any of `bodies` (m, 3), m."""
+    return float(np.linalg.norm(hands[:, None] - bodies[None], axis=-1).min())
+
+
+def _millimetre(value_m: float) -> float:
+    return round(float(value_m), MEASURE_DECIMALS)
+
+
 def failure_stage(reach: dict[str, float]) -> str:
-    """Where a failed episode stopped (one of FAILURE_STAGES), from its `reach` summary."""
+    """Where a failed episode stopped (one of FAILURE_STAGES), from its `reach` summary. Logs written before the
+    other props were measured (no `closest_hand_other_m`) count a target never reached as `not_reached`."""
     if reach["closest_hand_m"] > REACHED_M:
-        return "not_reached"
+        other = reach.get("closest_hand_other_m")
+        return "reached_other" if other is not None and other <= REACHED_M else "not_reached"
     return "reached_not_moved" if reach["target_moved_m"] < MOVED_M else "moved_no_success"

@@ -274,12 +274,14 @@ def _failure_table(cells: dict, tasks: list[str], splits: list[str]) -> list[str
             rows.append(f"| {task} | {split} | {sum(stages.values())} | {counts} | {offsets} |")
     if not rows:
         return []
-    caption = (f"Failed episodes by how far they got: no hand within {100 * REACHED_M:.0f} cm of the target's "
-               f"centre; a hand there but the target moved less than {100 * MOVED_M:.0f} cm; the target moved, "
-               "no success. Then the median horizontal distance from the target's centre at which the first grasp "
-               "of it closed, in failed and in successful episodes.")
-    return ["", caption, "", "| task | split | failed | not reached | reached, not moved | moved, no success "
-            "| first grasp off centre (mm), failed / succeeded |", "|---|---|---|---|---|---|---|", *rows]
+    caption = (f"Failed episodes by how far they got: a hand within {100 * REACHED_M:.0f} cm of another object's "
+               "centre, never of the target's (episodes logged before this was measured count as not reached); "
+               f"no hand within {100 * REACHED_M:.0f} cm of either; a hand at the target but the target moved less "
+               f"than {100 * MOVED_M:.0f} cm; the target moved, no success. Then the median horizontal distance from "
+               "the target's centre at which the first grasp of it closed, in failed and in successful episodes.")
+    header = ("| task | split | failed | reached another object | not reached | reached, not moved | moved, no success "
+              "| first grasp off centre (mm), failed / succeeded |")
+    return ["", caption, "", header, "|---|---|---|---|---|---|---|---|", *rows]
 
 
 def _millimetres(value_m: float | None) -> str:

@@ -187,7 +187,11 @@ def test_reach_tells_a_hand_that_never_got_to_the_target(small_env):
         *_, info = env.step(action)
     reach = info["reach"]
     assert reach["closest_hand_m"] > REACHED_M and reach["target_moved_m"] < MOVED_M
+    assert REACHED_M < reach["closest_hand_other_m"] < 1.0  # the other object on the table, not an off-stage one
     assert reach["first_grasp_xy_m"] is None
     assert failure_stage(reach) == "not_reached"
-    assert failure_stage({"closest_hand_m": 0.01, "target_moved_m": 0.0}) == "reached_not_moved"
+    assert failure_stage({**reach, "closest_hand_other_m": 0.03}) == "reached_other"
+    assert failure_stage({"closest_hand_m": 0.2, "target_moved_m": 0.0}) == "not_reached"  # logged before "other"
+    assert failure_stage({"closest_hand_m": 0.01, "closest_hand_other_m": 0.03, "target_moved_m": 0.0}) == \
+        "reached_not_moved"
     assert failure_stage({"closest_hand_m": 0.01, "target_moved_m": 0.1}) == "moved_no_success"
