@@ -8,6 +8,8 @@ and InputError are ValueErrors), so `except ValueError` keeps working. Any other
 command lets it through with its traceback.
 """
 
+from __future__ import annotations
+
 
 class TavisError(Exception):
     """Base class: bad input, damaged files, a replay that differs from its recording, an unreachable Hub."""
@@ -21,7 +23,9 @@ class InputError(TavisError, ValueError):
 class FieldError(InputError):
     """A bad value of one named field of a config or function; the `tavis` command names its option instead."""
 
-    def __init__(self, field: str, problem: str):
+    def __init__(self, field: str | FieldError, problem: str | None = None):
+        if isinstance(field, FieldError) and problem is None:  # gymnasium re-raises a worker's error as type(e)(e)
+            field, problem = field.field, field.problem
         super().__init__(f"{field} {problem}")
         self.field = field
         self.problem = problem

@@ -18,7 +18,7 @@ envs. This module gives the same two behaviours from classes that import only gy
   step for 32 envs, one H100 machine); a prompt changes only at a reset, so it is asked once per reset.
   `worker_niceness` lowers the workers' CPU priority (added to their niceness, as `nice`), so that the process that
   runs the policy is not delayed by them when the cores are contended. `retarget` gives started workers other
-  sub-envs (another task or split, same spaces) without starting new processes.
+  sub-envs (another task or split, same spaces) without starting new processes, and without waiting for them.
 """
 
 from __future__ import annotations
@@ -115,6 +115,7 @@ class LazyAsyncVectorEnv:
                  action_space: gym.Space, metadata: dict, filmed_envs: int = 10, worker_niceness: int = 0):
         self._worker_niceness = worker_niceness
         self._env: gym.vector.AsyncVectorEnv | None = None
+        self._retargeting = False  # the workers were asked to retarget and have not all answered yet
         self._set_factories(factories, filmed_envs)
         self.num_envs = len(factories)
         self.observation_space = self.single_observation_space = observation_space
@@ -129,12 +130,15 @@ class LazyAsyncVectorEnv:
     def retarget(self, factories: list[Callable[[], gym.Env]], filmed_envs: int) -> None:
         """Serve the sub-envs of `factories` (as many as now, with the same spaces: another task or split) from the
         next reset on. Started workers close their sub-env and build the new one in the same process, so its
-        imports and its GL context are not paid again; only the first `filmed_envs` of them draw frames."""
+        imports and its GL context are not paid again; only the first `filmed_envs` of them draw frames. This
+        returns at once: the workers build while this process goes on (a policy job loads its policy meanwhile),
+        and the next use of the batch waits for them (and raises a worker's error)."""
         if len(factories) != self.num_envs:
             raise ValueError(f"retarget: {len(factories)} sub-env factories for a batch of {self.num_envs}")
         self._set_factories(factories, filmed_envs)
         if self._env is not None:
-            self._env.call("retarget", self._frozen)
+            self._started().call_async("retarget", self._frozen)
+            self._retargeting = True
 
     @property
     def unwrapped(self) -> LazyAsyncVectorEnv:
@@ -145,6 +149,9 @@ class LazyAsyncVectorEnv:
             workers = [WorkerEnv(self._frozen, index, self._worker_niceness) for index in range(self.num_envs)]
             self._env = gym.vector.AsyncVectorEnv(workers, context="forkserver", shared_memory=True,
                                                   autoreset_mode=gym.vector.AutoresetMode.NEXT_STEP)
+        elif self._retargeting:
+            self._retargeting = False
+            self._env.call_wait()
         return self._env
 
     def reset(self, **kwargs):
@@ -170,5 +177,6 @@ class LazyAsyncVectorEnv:
 
     def close(self) -> None:
         if self._env is not None:
-            self._env.close()
+            self._env.close()  # waits for a retarget still under way
             self._env = None
+            self._retargeting = False

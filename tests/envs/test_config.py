@@ -174,6 +174,22 @@ def test_retargeted_workers_build_the_new_task_in_the_same_processes():
         vec.close()
 
 
+def test_a_retarget_that_fails_in_the_workers_raises_at_the_next_use():
+    """`retarget` does not wait for the workers; their error comes with the next reset, naming what was wrong."""
+    from lerobot_tavis.envs.factory import make_tavis_env
+    from lerobot_tavis.errors import FieldError
+
+    vec = TavisEnvConfig(task="wait_then_act", image_size=(24, 32)).create_envs(2, True)["tavis_head"][0]
+    try:
+        vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+        broken = partial(make_tavis_env, "conditional_pick", "gr1t2", "head_wrist", "no_split", (24, 32), 20.0)
+        vec.retarget([broken] * 2, filmed_envs=0)
+        with pytest.raises(FieldError, match="split must be one of"):  # the worker's error, type and message
+            vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+    finally:
+        vec.close()
+
+
 def test_a_negative_filmed_env_count_is_refused():
     with pytest.raises(ValueError, match="filmed_envs must be an integer >= 0"):
         TavisEnvConfig(filmed_envs=-1)
