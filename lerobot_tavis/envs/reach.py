@@ -26,7 +26,8 @@ class ReachTracker:
 
     def __init__(self, data: mujoco.MjData, target_body: int, grasp_sites: dict[str, int],
                  other_bodies: tuple[int, ...] = ()):
-        self._body, self._sites, self._others = target_body, grasp_sites, other_bodies
+        self._body, self._sites = target_body, grasp_sites
+        self._hand_ids, self._others = np.array(list(grasp_sites.values())), np.array(other_bodies, dtype=int)
         self._start = data.xpos[target_body].copy()
         self._closed = dict.fromkeys(grasp_sites, False)
         self.closest_hand_m, self.target_moved_m = np.inf, 0.0
@@ -50,16 +51,16 @@ class ReachTracker:
         """`{"closest_hand_m", "closest_hand_other_m", "target_moved_m", "first_grasp_xy_m"}`, to the millimetre as
         the success conditions are."""
         return {"closest_hand_m": _millimetre(self.closest_hand_m),
-                "closest_hand_other_m": _millimetre(self.closest_hand_other_m) if self._others else None,
+                "closest_hand_other_m": _millimetre(self.closest_hand_other_m) if self._others.size else None,
                 "target_moved_m": _millimetre(self.target_moved_m),
                 "first_grasp_xy_m": None if self.first_grasp_xy_m is None else _millimetre(self.first_grasp_xy_m)}
 
     def _measure(self, data: mujoco.MjData) -> None:
-        hands = data.site_xpos[list(self._sites.values())]
+        hands = data.site_xpos[self._hand_ids]
         target = data.xpos[self._body]
         self.closest_hand_m = min(self.closest_hand_m, _nearest(hands, target[None]))
-        if self._others:
-            self.closest_hand_other_m = min(self.closest_hand_other_m, _nearest(hands, data.xpos[list(self._others)]))
+        if self._others.size:
+            self.closest_hand_other_m = min(self.closest_hand_other_m, _nearest(hands, data.xpos[self._others]))
         self.target_moved_m = max(self.target_moved_m, float(np.linalg.norm(target - self._start)))
 
 
