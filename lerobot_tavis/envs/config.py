@@ -113,7 +113,7 @@ class TavisEnvConfig(EnvConfig):
             envs[suite] = {}
             for task_id, factory in factories.items():
                 if use_async_envs and n_envs > 1:
-                    probe = factory.func(factory.args[0], **self.gym_kwargs)  # spaces only: builds no simulator
+                    probe = factory(episode_log=None)  # spaces only: builds no simulator, logs nothing
                     envs[suite][task_id] = LazyAsyncVectorEnv([factory] * n_envs, probe.observation_space,
                                                               probe.action_space, probe.metadata,
                                                               filmed_envs=self.filmed_envs,

@@ -35,26 +35,27 @@ def annotate_videos(eval_dirs: Sequence[Path], workers: int, fps: int = POLICY_H
             if not (out.exists() and out.stat().st_mtime_ns > video.stat().st_mtime_ns)]
     if not jobs:
         return []
-    with executor(min(workers, len(jobs))) as pool:
-        pending = [(out, pool.submit(annotated_mp4, video, record, fps)) for video, out, record in jobs]
-        return [write_bytes(out, future.result()) for out, future in pending]
+    with Annotator(min(workers, len(jobs)), fps, niceness=0) as annotator:
+        for video, out, record in jobs:
+            annotator.submit("report", video, out, record)
+        return annotator.write("report")
 
 
 class Annotator:
-    """Annotates videos in the background: `submit` hands a video to one of `workers` processes, which run at the
-    lowest CPU priority (they take only the cores nobody else wants, e.g. between a protocol's rollouts), and
-    `write(group)` waits for a group's copies and writes them from this process. Workers start at the first
-    `submit`; with one worker, `submit` annotates at once."""
+    """Annotates videos in the background: `submit` hands a video to one of `workers` processes, which run at
+    `niceness` (by default the lowest CPU priority: they take only the cores nobody else wants, e.g. between a
+    protocol's rollouts), and `write(group)` waits for a group's copies and writes them from this process. Workers
+    start at the first `submit`; with one worker, `submit` annotates at once."""
 
-    def __init__(self, workers: int, fps: int = POLICY_HZ):
-        self._workers, self._fps = workers, fps
+    def __init__(self, workers: int, fps: int = POLICY_HZ, niceness: int = MAX_NICENESS):
+        self._workers, self._fps, self._niceness = workers, fps, niceness
         self._pool = None
         self._pending: dict[object, list[tuple[Path, Future]]] = {}
 
     def submit(self, group, video: Path, out: Path, record: dict) -> None:
         """Annotate `video` (an episode filmed at the annotator's fps) from its log `record`, as `out`, in `group`."""
         if self._pool is None:
-            self._pool = executor(self._workers, niceness=MAX_NICENESS)
+            self._pool = executor(self._workers, niceness=self._niceness)
         self._pending.setdefault(group, []).append((out, self._pool.submit(annotated_mp4, video, record, self._fps)))
 
     def write(self, group) -> list[Path]:
