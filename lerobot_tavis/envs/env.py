@@ -79,7 +79,8 @@ class TavisEnv(gym.Env):
     `info["conditions"]` holds the parts of the task's success rule (`Task.evaluate` less "success", which is
     `info["is_success"]`), e.g. `{"target_lifted": True, "target_slow": False, "target_height_m": 1.31, ...}`, and
     `info["reach"]` how far the episode has got toward a task's target so far (`lerobot_tavis.envs.reach`):
-    `{"closest_hand_m": 0.012, "closest_hand_other_m": 0.31, "target_moved_m": 0.25, "first_grasp_xy_m": 0.004}`,
+    `{"closest_hand_m": 0.012, "closest_hand_other_m": 0.31, "target_moved_m": 0.25, "first_grasp_xy_m": 0.004,
+    "command_gap_m": 0.003}`,
     or None for a task without one.
     """
 
@@ -172,7 +173,7 @@ class TavisEnv(gym.Env):
             return self._observe(sim), 0.0, False, True, info
         self._task.after_step(sim.model, sim.data, self._steps / self.fps)
         if self._reach is not None:
-            self._reach.update(sim.data, applied)
+            self._reach.update(sim.data, applied, sim.controller.measured_state(sim.data))
         evaluation = self._task.evaluate(sim.data)
         success = bool(evaluation["success"])
         if success and self._success_s is None:

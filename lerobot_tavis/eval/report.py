@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_tavis.atomic import atomic_path, write_text
-from lerobot_tavis.envs.reach import FAILURE_STAGES, MOVED_M, REACHED_M, failure_stage
+from lerobot_tavis.envs.reach import FAILURE_STAGES, HELD_BACK_M, MOVED_M, REACHED_M, failure_stage, held_back
 from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
@@ -67,6 +67,7 @@ class Cell:
     metrics: dict[str, LeadTimes] = field(default_factory=lambda: {m.name: LeadTimes() for m in episode_metrics()})
     unstable: int = 0  # episodes ended by a simulator instability (counted as failures)
     failure_stages: Counter = field(default_factory=Counter)  # failed episodes with a `reach`, by stage
+    not_reached_held_back: list[bool] = field(default_factory=list)  # per not-reached failure logged with a gap
     first_grasps_xy_m: dict[str, list[float]] = field(default_factory=lambda: {"failure": [], "success": []})
 
     def add(self, record: dict) -> None:
@@ -77,7 +78,11 @@ class Cell:
         self.unstable += bool(record.get("instability"))
         reach = record.get("reach")
         if reach and not record["success"]:
-            self.failure_stages[failure_stage(reach)] += 1
+            stage = failure_stage(reach)
+            self.failure_stages[stage] += 1
+            held = held_back(reach)
+            if stage == "not_reached" and held is not None:
+                self.not_reached_held_back.append(held)
         if reach and reach.get("first_grasp_xy_m") is not None:
             self.first_grasps_xy_m["success" if record["success"] else "failure"].append(reach["first_grasp_xy_m"])
 
@@ -89,6 +94,7 @@ class Cell:
             "success_rate": k / n if n else 0.0, "ci_low": low, "ci_high": high, "unstable": self.unstable,
             "failure_stages": {stage: self.failure_stages[stage] for stage in FAILURE_STAGES} if self.failure_stages
             else {},
+            "not_reached_held_back": sum(self.not_reached_held_back) if self.not_reached_held_back else None,
             **{f"first_grasp_xy_median_m_{outcome}": float(np.median(values)) if values else None
                for outcome, values in self.first_grasps_xy_m.items()},
             **{key: value for name, times in self.metrics.items() for key, value in times.summary(name).items()},
@@ -269,19 +275,24 @@ def _failure_table(cells: dict, tasks: list[str], splits: list[str]) -> list[str
         stages = cell.get("failure_stages")
         if stages:
             counts = " | ".join(str(stages[stage]) for stage in FAILURE_STAGES)
+            held = cell.get("not_reached_held_back")
             offsets = " / ".join(_millimetres(cell.get(f"first_grasp_xy_median_m_{outcome}"))
                                  for outcome in ("failure", "success"))
-            rows.append(f"| {task} | {split} | {sum(stages.values())} | {counts} | {offsets} |")
+            rows.append(f"| {task} | {split} | {sum(stages.values())} | {counts} | {'-' if held is None else held} "
+                        f"| {offsets} |")
     if not rows:
         return []
     caption = (f"Failed episodes by how far they got: a hand within {100 * REACHED_M:.0f} cm of another object's "
                "centre, never of the target's (episodes logged before this was measured count as not reached); "
                f"no hand within {100 * REACHED_M:.0f} cm of either; a hand at the target but the target moved less "
-               f"than {100 * MOVED_M:.0f} cm; the target moved, no success. Then the median horizontal distance from "
-               "the target's centre at which the first grasp of it closed, in failed and in successful episodes.")
+               f"than {100 * MOVED_M:.0f} cm; the target moved, no success. Then how many not-reached episodes ended "
+               f"with a hand over {100 * HELD_BACK_M:.0f} cm from its commanded position (held back by an object or "
+               "its reach; the others stopped short where commanded; - for logs without it), and the median "
+               "horizontal distance from the target's centre at which the first grasp of it closed, in failed and "
+               "in successful episodes.")
     header = ("| task | split | failed | reached another object | not reached | reached, not moved | moved, no success "
-              "| first grasp off centre (mm), failed / succeeded |")
-    return ["", caption, "", header, "|---|---|---|---|---|---|---|---|", *rows]
+              "| not reached, held back | first grasp off centre (mm), failed / succeeded |")
+    return ["", caption, "", header, "|---|---|---|---|---|---|---|---|---|", *rows]
 
 
 def _millimetres(value_m: float | None) -> str:

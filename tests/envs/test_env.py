@@ -9,7 +9,7 @@ from gymnasium.utils.env_checker import check_env
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_MODES
-from lerobot_tavis.envs.reach import MOVED_M, REACHED_M, failure_stage
+from lerobot_tavis.envs.reach import HELD_BACK_M, MOVED_M, REACHED_M, failure_stage, held_back
 from lerobot_tavis.overlay import Caption, compose
 from tests.conftest import run_steps
 
@@ -195,3 +195,16 @@ def test_reach_tells_a_hand_that_never_got_to_the_target(small_env):
     assert failure_stage({"closest_hand_m": 0.01, "closest_hand_other_m": 0.03, "target_moved_m": 0.0}) == \
         "reached_not_moved"
     assert failure_stage({"closest_hand_m": 0.01, "target_moved_m": 0.1}) == "moved_no_success"
+
+
+def test_reach_tells_a_hand_held_back_from_one_that_stopped_where_commanded(small_env):
+    env = small_env(task="conditional_pick")
+    env.reset(seed=1000)
+    *_, info = env.step(canonical.rest_action())
+    assert held_back(info["reach"]) is False and info["reach"]["command_gap_m"] < HELD_BACK_M
+    out_of_reach = canonical.rest_action()
+    out_of_reach[canonical.LEFT.position] = (0.3, 1.2, 0.3)  # a metre to the robot's left
+    for _ in range(10):
+        *_, info = env.step(out_of_reach)
+    assert held_back(info["reach"]) is True and info["reach"]["command_gap_m"] > 0.3
+    assert held_back({"closest_hand_m": 0.2, "target_moved_m": 0.0}) is None  # logged before the gap was

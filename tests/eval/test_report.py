@@ -76,23 +76,27 @@ def test_report_summarises_the_wrist_lead_of_hands_tasks(tmp_path):
 def test_report_counts_failed_episodes_by_how_far_they_got(tmp_path):
     path = tmp_path / "run"
     path.mkdir()
-    reaches = [(0.20, 0.0, None, 0.3), (0.30, 0.01, None, None), (0.01, 0.005, 0.012, 0.2), (0.02, 0.30, 0.02, 0.2),
-               (0.01, 0.40, 0.003, 0.2), (0.25, 0.0, None, 0.04),
+    # closest hand, target moved, first grasp off centre, closest hand to another object, command gap at the end
+    reaches = [(0.20, 0.0, None, 0.3, 0.15), (0.30, 0.01, None, None, None), (0.01, 0.005, 0.012, 0.2, 0.001),
+               (0.02, 0.30, 0.02, 0.2, 0.0), (0.01, 0.40, 0.003, 0.2, 0.0), (0.25, 0.0, None, 0.04, 0.2),
+               (0.07, 0.0, None, 0.3, 0.004),
                None]  # the second was logged before `closest_hand_other_m` existed, the last before `reach`
-    successes = [False, False, False, False, True, False, False]
+    successes = [False, False, False, False, True, False, False, False]
     records = [{**_record("conditional_pick", 0, 1000 + ix, success),
                 "reach": reach and {"closest_hand_m": reach[0], "target_moved_m": reach[1],
                                     "first_grasp_xy_m": reach[2],
-                                    **({} if reach[3] is None else {"closest_hand_other_m": reach[3]})}}
+                                    **({} if reach[3] is None else {"closest_hand_other_m": reach[3]}),
+                                    **({} if reach[4] is None else {"command_gap_m": reach[4]})}}
                for ix, (reach, success) in enumerate(zip(reaches, successes))]
     (path / "eval_info.json").write_text(json.dumps(
         {"per_task": [{"task_group": "tavis_head", "task_id": 0, "metrics": {"successes": successes}}]}))
     (path / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
     (cell,) = build_report(tmp_path)["cells"]
-    assert cell["failure_stages"] == {"reached_other": 1, "not_reached": 2, "reached_not_moved": 1,
+    assert cell["failure_stages"] == {"reached_other": 1, "not_reached": 3, "reached_not_moved": 1,
                                       "moved_no_success": 1}
+    assert cell["not_reached_held_back"] == 1  # of the two not-reached episodes logged with a gap
     assert cell["first_grasp_xy_median_m_failure"] == 0.016 and cell["first_grasp_xy_median_m_success"] == 0.003
-    assert "| conditional_pick | id | 5 | 1 | 2 | 1 | 1 | 16 / 3 |" in markdown(build_report(tmp_path))
+    assert "| conditional_pick | id | 6 | 1 | 3 | 1 | 1 | 1 | 16 / 3 |" in markdown(build_report(tmp_path))
 
 
 def test_no_failure_table_without_reach_records(tmp_path):
