@@ -14,7 +14,9 @@
 # `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1" for
 # ACT's temporal ensembling), TRAIN_OPTIONS (more lerobot-train arguments, e.g. "--policy.chunk_size=40
 # --policy.n_action_steps=20"), EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), CHECKPOINTS (which
-# `eval` takes: all, or last), WORK (/tmp/tavis_baseline).
+# `eval` takes: all, or last), STATE_INPUT (on; off: the policy sees its cameras alone, a copy of the preset without
+# the observation.state input written to WORK, to tell a policy that copies its own pose from one that needs it),
+# WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
@@ -50,6 +52,7 @@ FILM=${FILM:-2}
 EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
 SEED=${SEED:-1000}
 CHECKPOINTS=${CHECKPOINTS:-all}
+STATE_INPUT=${STATE_INPUT:-on}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 read -ra train_options <<< "${TRAIN_OPTIONS:-}"
 WORK=${WORK:-/tmp/tavis_baseline}
@@ -62,6 +65,10 @@ esac
 case "$CHECKPOINTS" in
   all|last) ;;
   *) echo "CHECKPOINTS must be all or last, got '$CHECKPOINTS'" >&2; exit 2 ;;
+esac
+case "$STATE_INPUT" in
+  on|off) ;;
+  *) echo "STATE_INPUT must be on or off, got '$STATE_INPUT'" >&2; exit 2 ;;
 esac
 SIZE=120x160
 HERE=$(cd "$(dirname "$0")" && pwd)
@@ -92,10 +99,27 @@ while chunk := os.read(0, 1 << 16):
         sys.exit(3)
     seen = chunk'
 
+preset() {  # prints the path of the condition's compact preset; with STATE_INPUT=off, of a copy without the state
+  local shipped copy="$WORK/preset_act_${CONDITION}_compact_no_state.json"
+  shipped=$(tavis presets "act_${CONDITION}_compact")
+  if [ "$STATE_INPUT" = on ]; then echo "$shipped"; return; fi
+  mkdir -p "$WORK"
+  python3 - "$shipped" "$copy" <<'PY'
+import json, os, sys
+preset = json.load(open(sys.argv[1]))
+del preset["policy"]["input_features"]["observation.state"]
+with open(sys.argv[2] + ".tmp", "w") as copy:
+    json.dump(preset, copy, indent=2)
+os.replace(sys.argv[2] + ".tmp", sys.argv[2])
+PY
+  echo "$copy"
+}
+
 train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]: fails with 3, the run stopped, at a NaN loss
-  local dataset=$1 out=$2 status=0
+  local dataset=$1 out=$2 status=0 config
   shift 2
-  lerobot-train --config_path="$(tavis presets "act_${CONDITION}_compact")" \
+  config=$(preset)
+  lerobot-train --config_path="$config" \
     --dataset.repo_id="local/$(basename "$dataset")" --dataset.root="$dataset" --dataset.video_backend="$BACKEND" \
     --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true --num_workers="$WORKERS" \
     --seed="$SEED" --log_freq=100 --output_dir="$out" "${train_options[@]}" "$@" 2>&1 \

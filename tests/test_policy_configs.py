@@ -1,5 +1,6 @@
-"""Policy presets: they parse with LeRobot's loader, match a converted dataset and the env, and a diffusion preset
-trains, evaluates periodically on the tavis env and leaves a checkpoint that lerobot-eval runs."""
+"""Policy presets: they parse with LeRobot's loader, match a converted dataset and the env, a diffusion preset
+trains, evaluates periodically on the tavis env and leaves a checkpoint that lerobot-eval runs, and a compact ACT
+without the state input trains and runs in `tavis eval`."""
 
 import json
 import os
@@ -131,6 +132,29 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
     subprocess.run(evaluate, check=True, capture_output=True, env=env, timeout=600)
     info = json.loads((tmp_path / "eval" / "eval_info.json").read_text())
     assert info["overall"]["n_episodes"] == 1
+
+
+def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path):
+    """benchmarks/train_baseline.sh's STATE_INPUT=off: the preset's inputs less observation.state."""
+    preset = json.loads(preset_path("act_head_wrist_compact").read_text())
+    del preset["policy"]["input_features"]["observation.state"]
+    for feature in preset["policy"]["input_features"].values():
+        feature["shape"] = [3, *TINY]
+    (tmp_path / "preset.json").write_text(json.dumps(preset))
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={tmp_path / 'preset.json'}",
+             "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", "--env.task=conditional_pick",
+             "--policy.device=cpu", "--policy.dim_model=32", "--policy.dim_feedforward=64", "--policy.n_heads=2",
+             "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}"]
+    subprocess.run(train, check=True, capture_output=True, env=env, timeout=600)
+    checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
+    assert "observation.state" not in json.loads((checkpoint / "config.json").read_text())["input_features"]
+    evaluate = [sys.executable, "-m", "lerobot_tavis.cli", "eval", "--policy", str(checkpoint), "--device", "cpu",
+                "--tasks", "conditional_pick", "--splits", "id", "--episodes", "1", "--workers", "1",
+                "--batch-size", "1", "--episode-length-s", "1", "--film-episodes", "0", "--out", str(tmp_path / "eval")]
+    subprocess.run(evaluate, check=True, capture_output=True, env=env, timeout=600)
+    (cell,) = json.loads((tmp_path / "eval" / "results.json").read_text())["cells"]
+    assert (cell["task"], cell["n"]) == ("conditional_pick", 1)
 
 
 def test_pi0_presets_say_clearly_what_is_missing_offline(tmp_path):

@@ -1,10 +1,13 @@
 """benchmarks/train_baseline.sh's orchestration, run with stand-ins for tavis and lerobot-train that record how
 they were called: which GPU each condition gets, and that every checkpoint is evaluated once."""
 
+import json
 import os
 import re
 import subprocess
 from pathlib import Path
+
+from lerobot_tavis.policy_configs import preset_path
 
 SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "train_baseline.sh"
 
@@ -12,7 +15,7 @@ SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "train_baseline.sh
 LOG_CALL = 'echo "$(basename "$0") $* | gpu=${CUDA_VISIBLE_DEVICES:-} egl=${MUJOCO_EGL_DEVICE_ID:-}" >> "$CALLS"\n'
 TAVIS = LOG_CALL + """case $1 in
   record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
-  presets) echo /dev/null ;;
+  presets) echo "${PRESET_FILE:-/dev/null}" ;;
   eval) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/results.json" ;;
 esac
 """
@@ -78,6 +81,26 @@ def test_train_options_reach_lerobot_train_before_the_modes_own_arguments(tmp_pa
     trains = [call.split(" | ")[0] for call in calls if call.startswith("lerobot-train")]
     assert len(trains) == 1
     assert "--policy.chunk_size=40 --policy.n_action_steps=20 --steps=800" in trains[0]
+
+
+def test_state_input_off_trains_from_a_copy_of_the_preset_without_the_state(tmp_path):
+    shipped = preset_path("act_head_wrist_compact")
+    (train,) = [call for call in _run(tmp_path, "train", STATE_INPUT="off", PRESET_FILE=str(shipped))
+                if call.startswith("lerobot-train")]
+    copy = Path(re.search(r"--config_path=(\S+)", train)[1])
+    assert copy.parent == tmp_path / "work" and not list(copy.parent.glob("*.tmp"))
+    expected = json.loads(shipped.read_text())
+    del expected["policy"]["input_features"]["observation.state"]
+    assert json.loads(copy.read_text()) == expected  # the cameras and everything else as shipped
+    assert sorted(expected["policy"]["input_features"]) == ["observation.images.head",
+                                                            "observation.images.left_wrist",
+                                                            "observation.images.right_wrist"]
+    (train,) = [call for call in _run(tmp_path / "default", "train", PRESET_FILE=str(shipped))
+                if call.startswith("lerobot-train")]
+    assert f"--config_path={shipped} " in train
+    refused = subprocess.run(["bash", str(SCRIPT), "train"], env={**os.environ, "STATE_INPUT": "no"},
+                             capture_output=True, text=True)
+    assert refused.returncode == 2 and "STATE_INPUT must be on or off, got 'no'" in refused.stderr
 
 
 def test_a_nan_loss_stops_the_training_run_and_fails_with_a_clear_message(tmp_path):
