@@ -207,4 +207,4 @@ def test_reach_tells_a_hand_held_back_from_one_that_stopped_where_commanded(smal
     for _ in range(10):
         *_, info = env.step(out_of_reach)
     assert held_back(info["reach"]) is True and info["reach"]["command_gap_m"] > 0.3
-    assert held_back({"closest_hand_m": 0.2, "target_moved_m": 0.0}) is None  # logged before the gap was
+    assert held_back({"closest_hand_m": 0.2, "target_moved_m": 0.0}) is None  # a log from before the gap
