@@ -84,6 +84,8 @@ def test_evaluate_decides_as_before_over_a_demonstration_and_the_log_keeps_its_c
     if result.success:  # a demonstrator's success brought a hand to the target, closed it there and moved it
         assert reach[-1]["closest_hand_m"] <= REACHED_M and reach[-1]["target_moved_m"] >= MOVED_M, reach[-1]
         assert 0.0 <= reach[-1]["first_grasp_xy_m"] <= 0.02, reach[-1]  # pads centred on the object
+        across_jaws = reach[-1]["first_grasp_in_hand_m"][1]  # the object's centre between the pads
+        assert abs(across_jaws) <= 0.012 and np.linalg.norm(reach[-1]["first_grasp_in_hand_m"]) <= REACHED_M, reach[-1]
 
 
 @pytest.mark.parametrize("task", ["conditional_pick", "clutter_pick_lift"])

@@ -80,7 +80,7 @@ class TavisEnv(gym.Env):
     `info["is_success"]`), e.g. `{"target_lifted": True, "target_slow": False, "target_height_m": 1.31, ...}`, and
     `info["reach"]` how far the episode has got toward a task's target so far (`lerobot_tavis.envs.reach`):
     `{"closest_hand_m": 0.012, "closest_hand_other_m": 0.31, "target_moved_m": 0.25, "first_grasp_xy_m": 0.004,
-    "command_gap_m": 0.003}`,
+    "first_grasp_in_hand_m": [0.001, -0.003, 0.012], "command_gap_m": 0.003}`,
     or None for a task without one.
     """
 

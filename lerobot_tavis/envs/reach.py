@@ -25,8 +25,9 @@ class ReachTracker:
     any), the farthest the target's origin got from where it was at the first observation (m), and the
     horizontal distance (m) from the target's origin to the grasp site of the first hand that closed its gripper
     within REACHED_M of it (None until one does; the demonstrators centre their pads on the object, so this is
-    how far off a grasp was placed); and after the latest step, the larger of the two arms' distances between the
-    commanded and the measured end-effector position (m)."""
+    how far off a grasp was placed) and, at that moment, the target's origin in that hand's frame (m: x along the
+    fingers' width, y across the jaws, z along the fingers toward the wrist); and after the latest step, the larger
+    of the two arms' distances between the commanded and the measured end-effector position (m)."""
 
     def __init__(self, data: mujoco.MjData, target_body: int, grasp_sites: dict[str, int],
                  other_bodies: tuple[int, ...] = ()):
@@ -37,6 +38,7 @@ class ReachTracker:
         self.closest_hand_m, self.target_moved_m = np.inf, 0.0
         self.closest_hand_other_m = np.inf
         self.first_grasp_xy_m: float | None = None
+        self.first_grasp_in_hand_m: np.ndarray | None = None
         self.command_gap_m = 0.0
         self._measure(data)
 
@@ -50,18 +52,22 @@ class ReachTracker:
         for arm in canonical.ARMS:
             closed = command[arm.gripper] > 0.0
             if closed and not self._closed[arm.side] and self.first_grasp_xy_m is None:
-                offset = data.site_xpos[self._sites[arm.side]] - target
+                site = self._sites[arm.side]
+                offset = data.site_xpos[site] - target
                 if np.linalg.norm(offset) <= REACHED_M:
                     self.first_grasp_xy_m = float(np.linalg.norm(offset[:2]))
+                    self.first_grasp_in_hand_m = data.site_xmat[site].reshape(3, 3).T @ -offset
             self._closed[arm.side] = closed
 
-    def summary(self) -> dict[str, float | None]:
-        """`{"closest_hand_m", "closest_hand_other_m", "target_moved_m", "first_grasp_xy_m", "command_gap_m"}`, to
-        the millimetre as the success conditions are."""
+    def summary(self) -> dict[str, float | list[float] | None]:
+        """`{"closest_hand_m", "closest_hand_other_m", "target_moved_m", "first_grasp_xy_m",
+        "first_grasp_in_hand_m", "command_gap_m"}`, to the millimetre as the success conditions are."""
         return {"closest_hand_m": _millimetre(self.closest_hand_m),
                 "closest_hand_other_m": _millimetre(self.closest_hand_other_m) if self._others.size else None,
                 "target_moved_m": _millimetre(self.target_moved_m),
                 "first_grasp_xy_m": None if self.first_grasp_xy_m is None else _millimetre(self.first_grasp_xy_m),
+                "first_grasp_in_hand_m": None if self.first_grasp_in_hand_m is None
+                else [_millimetre(value) for value in self.first_grasp_in_hand_m],
                 "command_gap_m": _millimetre(self.command_gap_m)}
 
     def _measure(self, data: mujoco.MjData) -> None:

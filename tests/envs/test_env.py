@@ -2,6 +2,7 @@
 
 import pickle
 
+import mujoco
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
@@ -9,7 +10,7 @@ from gymnasium.utils.env_checker import check_env
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_MODES
-from lerobot_tavis.envs.reach import HELD_BACK_M, MOVED_M, REACHED_M, failure_stage, held_back
+from lerobot_tavis.envs.reach import HELD_BACK_M, MOVED_M, REACHED_M, ReachTracker, failure_stage, held_back
 from lerobot_tavis.overlay import Caption, compose
 from tests.conftest import run_steps
 
@@ -188,13 +189,29 @@ def test_reach_tells_a_hand_that_never_got_to_the_target(small_env):
     reach = info["reach"]
     assert reach["closest_hand_m"] > REACHED_M and reach["target_moved_m"] < MOVED_M
     assert REACHED_M < reach["closest_hand_other_m"] < 1.0  # the other object on the table, not an off-stage one
-    assert reach["first_grasp_xy_m"] is None
+    assert reach["first_grasp_xy_m"] is None and reach["first_grasp_in_hand_m"] is None
     assert failure_stage(reach) == "not_reached"
     assert failure_stage({**reach, "closest_hand_other_m": 0.03}) == "reached_other"
     assert failure_stage({"closest_hand_m": 0.2, "target_moved_m": 0.0}) == "not_reached"  # logged before "other"
     assert failure_stage({"closest_hand_m": 0.01, "closest_hand_other_m": 0.03, "target_moved_m": 0.0}) == \
         "reached_not_moved"
     assert failure_stage({"closest_hand_m": 0.01, "target_moved_m": 0.1}) == "moved_no_success"
+
+
+def test_reach_gives_the_first_grasp_in_the_closing_hand_s_frame():
+    # the left hand's grasp site turned 90 degrees about z (its x along world y), the target 1 cm ahead of it
+    model = mujoco.MjModel.from_xml_string("""<mujoco><worldbody>
+      <site name="left" pos="0 0 1" euler="0 0 90"/><site name="right" pos="0 -1 1"/>
+      <body name="target" pos="0.01 0 1"><freejoint/><geom size="0.01"/></body></worldbody></mujoco>""")
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    tracker = ReachTracker(data, model.body("target").id, {"left": 0, "right": 1})
+    closing = canonical.rest_action()
+    closing[canonical.LEFT.gripper] = canonical.GRIPPER_CLOSED
+    tracker.update(data, closing, closing)
+    reach = tracker.summary()
+    assert reach["first_grasp_xy_m"] == 0.01
+    assert reach["first_grasp_in_hand_m"] == [0.0, -0.01, 0.0]  # the target along the hand's -y
 
 
 def test_reach_tells_a_hand_held_back_from_one_that_stopped_where_commanded(small_env):
