@@ -172,8 +172,9 @@ class TavisEnv(gym.Env):
                     "instability": f"{unstable} at step {self._steps} ({self._steps / self.fps:.2f} s)"}
             return self._observe(sim), 0.0, False, True, info
         self._task.after_step(sim.model, sim.data, self._steps / self.fps)
+        state = sim.controller.measured_state(sim.data)
         if self._reach is not None:
-            self._reach.update(sim.data, applied, sim.controller.measured_state(sim.data))
+            self._reach.update(sim.data, applied, state)
         evaluation = self._task.evaluate(sim.data)
         success = bool(evaluation["success"])
         if success and self._success_s is None:
@@ -182,7 +183,7 @@ class TavisEnv(gym.Env):
         conditions = {name: value for name, value in evaluation.items() if name != "success"}
         info = {"is_success": success, "applied_action": applied, "conditions": conditions,
                 "reach": None if self._reach is None else self._reach.summary()}
-        return self._observe(sim), float(success), success, truncated, info
+        return self._observe(sim, state), float(success), success, truncated, info
 
     def render(self) -> np.ndarray:
         """A frame for people (the videos lerobot-eval writes): the third-person overview camera, rendered now,
@@ -277,11 +278,14 @@ class TavisEnv(gym.Env):
         others = tuple(sim.model.body(name).id for name in self._facts.props if name != self._facts.target)
         return ReachTracker(sim.data, sim.model.body(self._facts.target).id, sites, others)
 
-    def _observe(self, sim: _Sim) -> dict:
+    def _observe(self, sim: _Sim, state: np.ndarray | None = None) -> dict:
+        """The observation of the current state; `state`, its canonical state when the caller has it already."""
         self._last_frames = sim.rig.render(sim.data)
+        if state is None:
+            state = sim.controller.measured_state(sim.data)
         return {
             "pixels": dict(self._last_frames),
-            "agent_pos": sim.controller.measured_state(sim.data).astype(np.float32),
+            "agent_pos": state.astype(np.float32),
             "joint_pos": sim.data.qpos[sim.world.robot_joint_qpos].astype(np.float32),
         }
 
