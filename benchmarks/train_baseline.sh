@@ -16,6 +16,10 @@
 # --policy.n_action_steps=20"), EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), CHECKPOINTS (which
 # `eval` takes: all, or last), STATE_INPUT (on; off: the policy sees its cameras alone, a copy of the preset without
 # the observation.state input written to WORK, to tell a policy that copies its own pose from one that needs it),
+# STATE_NOISE (empty: off; POSITION_M,ROTATION_DEG, e.g. 0.02,5: `train` reads a copy of the dataset whose
+# observation.state hand poses carry fixed per-frame Gaussian noise of those standard deviations, metres per axis and
+# degrees per rotation-vector component, heads, grippers and actions exact: $WORK/dataset_<CONDITION>_state_noise,
+# made once by `tavis noise-state` with seed SEED; needs STATE_INPUT=on; `overfit` ignores it),
 # WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
@@ -53,6 +57,7 @@ EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
 SEED=${SEED:-1000}
 CHECKPOINTS=${CHECKPOINTS:-all}
 STATE_INPUT=${STATE_INPUT:-on}
+STATE_NOISE=${STATE_NOISE:-}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 read -ra train_options <<< "${TRAIN_OPTIONS:-}"
 WORK=${WORK:-/tmp/tavis_baseline}
@@ -70,6 +75,15 @@ case "$STATE_INPUT" in
   on|off) ;;
   *) echo "STATE_INPUT must be on or off, got '$STATE_INPUT'" >&2; exit 2 ;;
 esac
+if [ -n "$STATE_NOISE" ] && ! [[ "$STATE_NOISE" =~ ^[0-9]+(\.[0-9]+)?,[0-9]+(\.[0-9]+)?$ ]]; then
+  echo "STATE_NOISE must be empty (off) or POSITION_M,ROTATION_DEG, two decimal numbers >= 0 such as 0.02,5;" \
+    "got '$STATE_NOISE'" >&2
+  exit 2
+fi
+if [ -n "$STATE_NOISE" ] && [ "$STATE_INPUT" = off ]; then
+  echo "STATE_NOISE needs STATE_INPUT=on: with STATE_INPUT=off the policy sees no observation.state to noise" >&2
+  exit 2
+fi
 SIZE=120x160
 HERE=$(cd "$(dirname "$0")" && pwd)
 
@@ -111,6 +125,22 @@ del preset["policy"]["input_features"]["observation.state"]
 with open(sys.argv[2] + ".tmp", "w") as copy:
     json.dump(preset, copy, indent=2)
 os.replace(sys.argv[2] + ".tmp", sys.argv[2])
+PY
+  echo "$copy"
+}
+
+noisy_copy() {  # noisy_copy DATASET_DIR: makes DATASET_DIR_state_noise with STATE_NOISE and SEED once, prints it
+  local copy="$1_state_noise" position_m=${STATE_NOISE%,*} rotation_deg=${STATE_NOISE#*,}
+  # runs in $(...), where set -e does not hold: each failure returns
+  [ -d "$copy" ] || tavis noise-state "$1" --out "$copy" --position-m "$position_m" --rotation-deg "$rotation_deg" \
+    --seed "$SEED" >&2 || return
+  python3 - "$copy/meta/state_noise.json" "$position_m" "$rotation_deg" "$SEED" <<'PY' || return
+import json, sys
+made = json.load(open(sys.argv[1]))
+wanted = {"position_m": float(sys.argv[2]), "rotation_deg": float(sys.argv[3]), "seed": int(sys.argv[4])}
+if {key: made[key] for key in wanted} != wanted:
+    sys.exit(f"train_baseline: {sys.argv[1]} holds other noise than STATE_NOISE and SEED ask for ({wanted}); "
+             "remove that copy to make a new one")
 PY
   echo "$copy"
 }
@@ -177,7 +207,9 @@ case "${1:-}" in
     ;;
   train)
     choose_video_backend
-    time train "$WORK/dataset_$CONDITION" "$WORK/train_$CONDITION" ${STEPS:+--steps=$STEPS} \
+    dataset="$WORK/dataset_$CONDITION"
+    if [ -n "$STATE_NOISE" ]; then dataset=$(noisy_copy "$dataset"); fi
+    time train "$dataset" "$WORK/train_$CONDITION" ${STEPS:+--steps=$STEPS} \
       ${SAVE_FREQ:+--save_freq=$SAVE_FREQ} ${BATCH:+--batch_size=$BATCH}
     ;;
   eval)  # every complete checkpoint (up to the one `last` points at), so it may run while training goes on

@@ -23,6 +23,17 @@ class VerifyOptions:
 
 
 @dataclass(frozen=True)
+class NoiseStateOptions:
+    source_root: Path = option(help="the dataset directory (LeRobotDataset v3.0, canonical observation.state)",
+                               positional=True)
+    out_root: Path = option(help="where the noisy copy goes (must not exist)", flag="--out")
+    position_m: float = option(help="standard deviation of each hand position's noise per axis, m")
+    rotation_deg: float = option(help="standard deviation of each component of each hand's rotation-vector noise, "
+                                 "degrees")
+    seed: int = option(0, "seed of the noise: the same seed makes the same copy")
+
+
+@dataclass(frozen=True)
 class PushOptions:
     root: Path = option(help="the dataset directory (a `tavis convert` output)", positional=True)
     repo_id: str = option(help="<user>/<name> on the Hub")
@@ -109,6 +120,15 @@ def _verify_dataset(options: VerifyOptions) -> None:
     print(f"{len(checks)} episodes replay as recorded")
 
 
+def _noise_state(options: NoiseStateOptions) -> None:
+    from lerobot_tavis.dataset_tools.state_noise import write_state_noise_copy
+
+    summary = write_state_noise_copy(options.source_root, options.out_root, options.position_m, options.rotation_deg,
+                                     options.seed)
+    print(f"{options.out_root}: {summary.frames_changed} of {summary.frames} frames changed; hands moved "
+          f"{summary.mean_position_shift_mm:.1f} mm and turned {summary.mean_rotation_deg:.2f} deg on average")
+
+
 def _push(options: PushOptions) -> None:
     from lerobot_tavis.dataset_tools.hub import push_dataset
 
@@ -167,6 +187,8 @@ def build_parser() -> argparse.ArgumentParser:
         ("verify-dataset", VerifyOptions, _verify_dataset,
          "replay a converted dataset's actions open loop and check they reproduce its recorded states (exit 1 if "
          "not)"),
+        ("noise-state", NoiseStateOptions, _noise_state,
+         "copy a dataset with Gaussian noise on the hand poses of observation.state (a training augmentation)"),
         ("push", PushOptions, _push, "upload a converted dataset to the Hugging Face Hub, with its card"),
         ("pull", PullOptions, _pull, "download a TAVIS dataset from the Hugging Face Hub"),
         ("presets", PresetsOptions, _presets, "list the training presets, or print the path of one"),

@@ -7,6 +7,8 @@ import re
 import subprocess
 from pathlib import Path
 
+import pytest
+
 from lerobot_tavis.policy_configs import preset_path
 
 SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "train_baseline.sh"
@@ -17,6 +19,8 @@ TAVIS = LOG_CALL + """case $1 in
   record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
   presets) echo "${PRESET_FILE:-/dev/null}" ;;
   eval) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/results.json" ;;
+  noise-state) mkdir -p "$4/meta"  # noise-state SOURCE --out OUT --position-m P --rotation-deg R --seed S
+    printf '{"position_m": %s, "rotation_deg": %s, "seed": %s}' "$6" "$8" "${10}" > "$4/meta/state_noise.json" ;;
 esac
 """
 LEROBOT_TRAIN = LOG_CALL + """for arg in "$@"; do case $arg in --output_dir=*) out=${arg#*=} ;; esac; done
@@ -24,7 +28,8 @@ for step in 001500 003000; do mkdir -p "$out/checkpoints/$step"; ln -sfn $step "
 """
 
 
-def _run(tmp_path, mode, **settings) -> list[str]:
+def _stubbed(tmp_path, mode, **settings) -> subprocess.CompletedProcess:
+    """The script run in `mode` with the stand-ins first on PATH; their calls go to tmp_path / "calls.log"."""
     stubs = tmp_path / "bin"
     stubs.mkdir(parents=True)
     for name, body in (("tavis", TAVIS), ("lerobot-train", LEROBOT_TRAIN)):
@@ -32,7 +37,11 @@ def _run(tmp_path, mode, **settings) -> list[str]:
         (stubs / name).chmod(0o755)
     env = {**os.environ, "PATH": f"{stubs}:{os.environ['PATH']}", "CALLS": str(tmp_path / "calls.log"),
            "WORK": str(tmp_path / "work"), "WORKERS": "4", "TRAIN_S": "60", **settings}
-    subprocess.run(["bash", str(SCRIPT), mode], env=env, check=True, capture_output=True, timeout=300)
+    return subprocess.run(["bash", str(SCRIPT), mode], env=env, capture_output=True, text=True, timeout=300)
+
+
+def _run(tmp_path, mode, **settings) -> list[str]:
+    _stubbed(tmp_path, mode, **settings).check_returncode()
     return (tmp_path / "calls.log").read_text().splitlines()
 
 
@@ -101,6 +110,41 @@ def test_state_input_off_trains_from_a_copy_of_the_preset_without_the_state(tmp_
     refused = subprocess.run(["bash", str(SCRIPT), "train"], env={**os.environ, "STATE_INPUT": "no"},
                              capture_output=True, text=True)
     assert refused.returncode == 2 and "STATE_INPUT must be on or off, got 'no'" in refused.stderr
+
+
+def test_state_noise_trains_on_a_noisy_copy_made_once_with_the_training_seed(tmp_path):
+    work = tmp_path / "work"
+    dataset, copy = work / "dataset_head_wrist", work / "dataset_head_wrist_state_noise"
+    calls = _run(tmp_path / "first", "train", WORK=str(work), STATE_NOISE="0.02,5", SEED="7")
+    assert [call.split(" | ")[0] for call in calls if call.startswith("tavis noise-state")] == [
+        f"tavis noise-state {dataset} --out {copy} --position-m 0.02 --rotation-deg 5 --seed 7"]
+    (train,) = [call for call in calls if call.startswith("lerobot-train")]
+    assert f" --dataset.repo_id=local/{copy.name} --dataset.root={copy} " in train
+    calls = _run(tmp_path / "again", "train", WORK=str(work), STATE_NOISE="0.02,5", SEED="7")
+    assert [call.split()[:2] for call in calls] == [["tavis", "presets"], ["lerobot-train", "--config_path=/dev/null"]]
+    assert f" --dataset.root={copy} " in calls[1]
+    for other in (dict(STATE_NOISE="0.03,5", SEED="7"), dict(STATE_NOISE="0.02,5", SEED="8")):
+        folder = tmp_path / other["STATE_NOISE"] / other["SEED"]
+        refused = _stubbed(folder, "train", WORK=str(work), **other)
+        assert refused.returncode != 0 and "holds other noise than STATE_NOISE and SEED ask for" in refused.stderr
+        assert not (folder / "calls.log").exists()  # neither a new copy nor a training
+    (train,) = [call for call in _run(tmp_path / "off", "train", WORK=str(work)) if call.startswith("lerobot-train")]
+    assert f" --dataset.root={dataset} " in train
+
+
+@pytest.mark.parametrize("value", ["0.02", "0.02,5,1", "-0.02,5", "0.02,-5", ".02,5", "0.02;5", "two,5", " "])
+def test_a_bad_state_noise_is_refused_before_anything_runs(tmp_path, value):
+    refused = _stubbed(tmp_path, "train", STATE_NOISE=value)
+    assert refused.returncode == 2
+    assert f"STATE_NOISE must be empty (off) or POSITION_M,ROTATION_DEG, two decimal numbers >= 0 such as 0.02,5; " \
+           f"got '{value}'" in refused.stderr
+    assert not (tmp_path / "calls.log").exists()
+
+
+def test_state_noise_with_state_input_off_is_refused(tmp_path):
+    refused = _stubbed(tmp_path, "train", STATE_NOISE="0.02,5", STATE_INPUT="off")
+    assert refused.returncode == 2 and "STATE_NOISE needs STATE_INPUT=on" in refused.stderr
+    assert not (tmp_path / "calls.log").exists()
 
 
 def test_a_nan_loss_stops_the_training_run_and_fails_with_a_clear_message(tmp_path):
