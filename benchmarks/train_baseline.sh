@@ -14,7 +14,7 @@
 # `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1" for
 # ACT's temporal ensembling), TRAIN_OPTIONS (more lerobot-train arguments, e.g. "--policy.chunk_size=40
 # --policy.n_action_steps=20"), EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), CHECKPOINTS (which
-# `eval` takes: all, or last), STATE_INPUT (on; off: the policy sees its cameras alone, a copy of the preset without
+# `eval` takes: all, last, or one training step such as 1600), STATE_INPUT (on; off: the policy sees its cameras alone, a copy of the preset without
 # the observation.state input written to WORK, to tell a policy that copies its own pose from one that needs it),
 # STATE_NOISE (empty: off; POSITION_M,ROTATION_DEG, e.g. 0.02,5: `train` reads a copy of the dataset whose
 # observation.state hand poses carry fixed per-frame Gaussian noise of those standard deviations, metres per axis and
@@ -37,7 +37,7 @@
 #   (exit 3) instead of spending the slot on NaN checkpoints.
 # - eval: `tavis eval --policy` (LeRobot's evaluation loop, EVAL_JOBS runs of it sharing the GPU: one loop over
 #   48 envs stepped about 200 envs/s on 16 cores) on every complete checkpoint not yet evaluated (or the last
-#   alone: CHECKPOINTS=last), seeds from 1000, side by side; it can run beside `train`, which marks a checkpoint
+#   alone: CHECKPOINTS=last; one step's: CHECKPOINTS=1600), seeds from 1000, side by side; it can run beside `train`, which marks a checkpoint
 #   complete by pointing `checkpoints/last` at it, and beside another `eval` call, which skips the checkpoints that
 #   one is evaluating.
 # - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (3000) and
@@ -69,7 +69,7 @@ case "$CONDITION" in
 esac
 case "$CHECKPOINTS" in
   all|last) ;;
-  *) echo "CHECKPOINTS must be all or last, got '$CHECKPOINTS'" >&2; exit 2 ;;
+  *[!0-9]*) echo "CHECKPOINTS must be all, last or a training step, got '$CHECKPOINTS'" >&2; exit 2 ;;
 esac
 case "$STATE_INPUT" in
   on|off) ;;
@@ -217,7 +217,11 @@ case "${1:-}" in
     last=$(basename "$link")
     for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
       (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
-      [ "$CHECKPOINTS" = all ] || [ "$(basename "$checkpoint")" = "$last" ] || continue
+      case "$CHECKPOINTS" in
+        all) ;;
+        last) [ "$(basename "$checkpoint")" = "$last" ] || continue ;;
+        *) (( 10#$(basename "$checkpoint") == 10#$CHECKPOINTS )) || continue ;;
+      esac
       out="$WORK/$EVAL_NAME/step_$((10#$(basename "$checkpoint")))"
       [ -f "$out/results.json" ] && continue
       mkdir -p "$(dirname "$out")"

@@ -67,13 +67,20 @@ def test_eval_options_reach_tavis_eval_and_its_folder_is_eval_name(tmp_path):
                              f"--out {tmp_path}/work/eval_te/step_{step}") for call, step in zip(evals, (1500, 3000)))
 
 
-def test_checkpoints_last_evaluates_only_the_last_checkpoint_and_bad_values_are_refused(tmp_path):
+@pytest.mark.parametrize("checkpoints, step", [("last", 3000), ("1500", 1500), ("001500", 1500)])
+def test_checkpoints_picks_the_last_or_one_steps_checkpoint(tmp_path, checkpoints, step):
     _run(tmp_path, "train")
-    calls = _run(tmp_path / "again", "eval", WORK=str(tmp_path / "work"), CHECKPOINTS="last", EVAL_NAME="eval_te")
-    assert [call.split(" | ")[0].split(" --out ")[1] for call in calls] == [f"{tmp_path}/work/eval_te/step_3000"]
-    refused = subprocess.run(["bash", str(SCRIPT), "eval"], env={**os.environ, "CHECKPOINTS": "first"},
+    calls = _run(tmp_path / "again", "eval", WORK=str(tmp_path / "work"), CHECKPOINTS=checkpoints,
+                 EVAL_NAME="eval_te")
+    assert [call.split(" | ")[0].split(" --out ")[1] for call in calls] == [f"{tmp_path}/work/eval_te/step_{step}"]
+
+
+@pytest.mark.parametrize("checkpoints", ["first", "16o0", "-1600"])
+def test_checkpoints_other_values_are_refused(checkpoints):
+    refused = subprocess.run(["bash", str(SCRIPT), "eval"], env={**os.environ, "CHECKPOINTS": checkpoints},
                              capture_output=True, text=True)
-    assert refused.returncode == 2 and "CHECKPOINTS must be all or last, got 'first'" in refused.stderr
+    assert refused.returncode == 2
+    assert f"CHECKPOINTS must be all, last or a training step, got '{checkpoints}'" in refused.stderr
 
 
 def test_seed_reaches_lerobot_train_and_defaults_to_its_own(tmp_path):
