@@ -34,6 +34,7 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools.features import STATE_KEY
 from lerobot_tavis.dataset_tools.staging import staged_directory
+from lerobot_tavis.envs.transforms import quat_angles_rad
 from lerobot_tavis.errors import FieldError, InputError, PathExistsError, PathNotFoundError
 
 NOISE_RECORD = "meta/state_noise.json"
@@ -211,7 +212,8 @@ def _summary(source: Path, position_m: float, rotation_deg: float, seed: int, or
     before, after = (np.concatenate([states[e] for e in sorted(states)]).astype(np.float64)
                      for states in (originals, noisy))
     shifts_m = [np.linalg.norm(after[:, arm.position] - before[:, arm.position], axis=1) for arm in canonical.ARMS]
-    angles_deg = [_angle_deg(before[:, arm.quaternion], after[:, arm.quaternion]) for arm in canonical.ARMS]
+    angles_deg = [np.degrees(quat_angles_rad(before[:, arm.quaternion], after[:, arm.quaternion]))
+                  for arm in canonical.ARMS]
     return StateNoiseSummary(str(source), position_m, rotation_deg, seed, len(before),
                              int(np.any(after != before, axis=1).sum()), float(1000 * np.mean(shifts_m)),
                              float(np.mean(angles_deg)))
@@ -228,10 +230,3 @@ def _quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     aw, av, bw, bv = a[:, :1], a[:, 1:], b[:, :1], b[:, 1:]
     w = aw * bw - np.sum(av * bv, axis=1, keepdims=True)
     return np.concatenate([w, aw * bv + bw * av + np.cross(av, bv)], axis=1)
-
-
-def _angle_deg(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Angles (degrees, 0..180) of the rotations between orientations a and b (N, 4; any norm, either sign)."""
-    a, b = a.astype(np.float64), b.astype(np.float64)
-    cos_half = np.abs(np.sum(a * b, axis=1)) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-    return np.degrees(2 * np.arccos(np.clip(cos_half, 0.0, 1.0)))

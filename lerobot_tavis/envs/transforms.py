@@ -1,18 +1,22 @@
-"""Small rotation helpers. Quaternions are w, x, y, z; matrices rotate column vectors."""
+"""Small rotation helpers. Quaternions are w, x, y, z; matrices rotate column vectors. MuJoCo is imported where a
+helper uses it, so that metrics and dataset tools can share these without loading the simulator."""
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 
 def quat_from_matrix(matrix: np.ndarray) -> np.ndarray:
+    import mujoco
+
     quat = np.empty(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(matrix, dtype=float).reshape(9))
     return quat
 
 
 def matrix_from_quat(quat) -> np.ndarray:
+    import mujoco
+
     matrix = np.empty(9)
     mujoco.mju_quat2Mat(matrix, np.asarray(quat, dtype=float))
     return matrix.reshape(3, 3)
@@ -25,6 +29,8 @@ def axis_angle_quat(axis, angle_rad: float) -> np.ndarray:
 
 
 def quat_multiply(a, b) -> np.ndarray:
+    import mujoco
+
     out = np.empty(4)
     mujoco.mju_mulQuat(out, np.asarray(a, dtype=float), np.asarray(b, dtype=float))
     return out
@@ -34,6 +40,14 @@ def quat_angle_rad(a, b) -> float:
     """Angle of the rotation between two orientations, in [0, pi]."""
     dot = abs(float(np.dot(a, b)) / (np.linalg.norm(a) * np.linalg.norm(b)))
     return 2.0 * float(np.arccos(min(1.0, dot)))
+
+
+def quat_angles_rad(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Row-wise angles (rad, in [0, pi]) of the rotations between orientations q1 and q2 (..., 4; any norm; q and -q
+    are the same rotation)."""
+    q1 = q1 / np.linalg.norm(q1, axis=-1, keepdims=True)
+    q2 = q2 / np.linalg.norm(q2, axis=-1, keepdims=True)
+    return 2.0 * np.arccos(np.clip(np.abs(np.sum(q1 * q2, axis=-1)), 0.0, 1.0))
 
 
 def camera_quat(forward, up) -> np.ndarray:

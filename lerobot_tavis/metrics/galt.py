@@ -29,6 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from lerobot_tavis.envs.transforms import quat_angles_rad
+
 REASON_PRIORITY = {"no_grasp": 1, "no_hand_onset": 2, "no_fixation": 3, "outlier_low": 3, "outlier_high": 3}
 MIN_STEPS = 10
 
@@ -272,7 +274,7 @@ def _wrist_lead(side, anchor, position, quaternion, fps, params, steps) -> Wrist
     onset = hand_onset(move_speed, anchor, params.v_hand_thresh, steps["m"])
     if onset is None:
         return WristLead(side, t_grasp, "no_hand_onset")
-    turn = _angle_between(quaternion[:-1], quaternion[1:]) * fps
+    turn = quat_angles_rad(quaternion[:-1], quaternion[1:]) * fps
     turn_speed = np.append(turn, turn[-1])  # as channel_speed: forward differences, last value repeated
     still = (move_speed < params.v_hand_thresh) & (turn_speed < params.v_sac_thresh)
     start = onset
@@ -282,18 +284,11 @@ def _wrist_lead(side, anchor, position, quaternion, fps, params, steps) -> Wrist
         return WristLead(side, t_grasp, "no_fixation", t_hand_onset_s=onset / fps)
     settle = start
     while settle > 0 and (np.max(np.abs(position[settle - 1] - position[start])) < params.wrist_arrival_margin_m
-                          and _angle_between(quaternion[settle - 1], quaternion[start]) < params.arrival_margin_rad):
+                          and quat_angles_rad(quaternion[settle - 1], quaternion[start]) < params.arrival_margin_rad):
         settle -= 1
     lead = (anchor - settle) / fps
     reason = "outlier_high" if lead > params.outlier_max_s else "ok"
     return WristLead(side, t_grasp, reason, lead if reason == "ok" else None, settle / fps, onset / fps)
-
-
-def _angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
-    """Rotation angle (rad) between unit quaternions, row-wise; q and -q are the same rotation."""
-    q1 = q1 / np.linalg.norm(q1, axis=-1, keepdims=True)
-    q2 = q2 / np.linalg.norm(q2, axis=-1, keepdims=True)
-    return 2.0 * np.arccos(np.clip(np.abs(np.sum(q1 * q2, axis=-1)), 0.0, 1.0))
 
 
 def _checked(actions) -> np.ndarray:
