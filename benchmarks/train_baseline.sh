@@ -19,7 +19,9 @@
 # STATE_NOISE (empty: off; POSITION_M,ROTATION_DEG, e.g. 0.02,5: `train` reads a copy of the dataset whose
 # observation.state hand poses carry fixed per-frame Gaussian noise of those standard deviations, metres per axis and
 # degrees per rotation-vector component, heads, grippers and actions exact: $WORK/dataset_<CONDITION>_state_noise,
-# made once by `tavis noise-state` with seed SEED; needs STATE_INPUT=on; `overfit` ignores it),
+# made once by `tavis noise-state` with seed SEED; needs STATE_INPUT=on; `overfit` ignores it), ACTIONS (absolute;
+# hand_relative: the `act_hand_relative` policy, ACT whose chunks hold the arm poses in the frame of the hand as
+# measured when the chunk is planned, observation.state read as that anchor alone; needs STATE_INPUT=off),
 # WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
@@ -58,6 +60,7 @@ SEED=${SEED:-1000}
 CHECKPOINTS=${CHECKPOINTS:-all}
 STATE_INPUT=${STATE_INPUT:-on}
 STATE_NOISE=${STATE_NOISE:-}
+ACTIONS=${ACTIONS:-absolute}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 read -ra train_options <<< "${TRAIN_OPTIONS:-}"
 WORK=${WORK:-/tmp/tavis_baseline}
@@ -74,6 +77,15 @@ esac
 case "$STATE_INPUT" in
   on|off) ;;
   *) echo "STATE_INPUT must be on or off, got '$STATE_INPUT'" >&2; exit 2 ;;
+esac
+case "$ACTIONS" in
+  absolute) ;;
+  hand_relative) if [ "$STATE_INPUT" = on ]; then
+      echo "ACTIONS=hand_relative needs STATE_INPUT=off: act_hand_relative reads observation.state only as the" \
+        "anchor of its chunks, never as a network input" >&2
+      exit 2
+    fi ;;
+  *) echo "ACTIONS must be absolute or hand_relative, got '$ACTIONS'" >&2; exit 2 ;;
 esac
 if [ -n "$STATE_NOISE" ] && ! [[ "$STATE_NOISE" =~ ^[0-9]+(\.[0-9]+)?,[0-9]+(\.[0-9]+)?$ ]]; then
   echo "STATE_NOISE must be empty (off) or POSITION_M,ROTATION_DEG, two decimal numbers >= 0 such as 0.02,5;" \
@@ -114,14 +126,18 @@ while chunk := os.read(0, 1 << 16):
     seen = chunk'
 
 preset() {  # prints the path of the condition's compact preset; with STATE_INPUT=off, of a copy without the state
+  # input (and with ACTIONS=hand_relative, of the act_hand_relative policy)
   local shipped copy="$WORK/preset_act_${CONDITION}_compact_no_state.json"
+  [ "$ACTIONS" = absolute ] || copy="$WORK/preset_act_${CONDITION}_compact_${ACTIONS}.json"
   shipped=$(tavis presets "act_${CONDITION}_compact")
   if [ "$STATE_INPUT" = on ]; then echo "$shipped"; return; fi
   mkdir -p "$WORK"
-  python3 - "$shipped" "$copy" <<'PY'
+  python3 - "$shipped" "$copy" "$ACTIONS" <<'PY'
 import json, os, sys
 preset = json.load(open(sys.argv[1]))
 del preset["policy"]["input_features"]["observation.state"]
+if sys.argv[3] == "hand_relative":
+    preset["policy"]["type"] = "act_hand_relative"
 with open(sys.argv[2] + ".tmp", "w") as copy:
     json.dump(preset, copy, indent=2)
 os.replace(sys.argv[2] + ".tmp", sys.argv[2])

@@ -1,5 +1,15 @@
-"""The plugin module LeRobot imports in every CLI: registers `--env.type=tavis` (it loads LeRobot itself)."""
+"""The plugin module LeRobot imports in every CLI: registers `--env.type=tavis` (it loads LeRobot itself), and
+`--policy.type=act_hand_relative` where LeRobot's policies are loaded already, as lerobot-train and lerobot-eval load
+them before their plugins; the robot and teleop CLIs stay without them. Elsewhere
+`lerobot_tavis.policies.register_policy_types()` registers the policy type."""
+
+import sys
 
 from lerobot_tavis.envs.config import TavisEnvConfig
+
+if "lerobot.policies" in sys.modules:
+    from lerobot_tavis.policies import register_policy_types
+
+    register_policy_types()
 
 __all__ = ["TavisEnvConfig"]

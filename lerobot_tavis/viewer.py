@@ -24,6 +24,7 @@ from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import split_names, task_names
 from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError
+from lerobot_tavis.policies import register_policy_types
 
 DRIVERS = ("demonstrator", "policy", "paused")
 FREE_CAMERA = "free"  # the window's camera moved with the mouse
@@ -98,9 +99,10 @@ class PolicyDriver:
     conversion, the checkpoint's pre- and post-processors, `select_action` with its action queue."""
 
     def __init__(self, policy_path: str | Path, device: str = "cpu"):
-        import lerobot.policies  # noqa: F401  (registers the policy types)
         from lerobot.configs.policies import PreTrainedConfig
         from lerobot.policies.factory import get_policy_class, make_pre_post_processors
+
+        register_policy_types()
 
         path = Path(policy_path)
         if not (path / "config.json").is_file():

@@ -26,6 +26,13 @@ def test_plugin_import_registers_the_env_type_and_loads_nothing_heavy():
     assert not [m for m in added if m.startswith(HEAVY)]
 
 
+def test_where_lerobot_policies_are_loaded_the_plugin_registers_the_policy_type_too():
+    loaded = _modules_after("import lerobot.policies, lerobot_env_tavis; from lerobot.configs.policies import "
+                            "PreTrainedConfig; assert PreTrainedConfig.get_choice_class('act_hand_relative')"
+                            ".__name__ == 'ACTHandRelativeConfig'")
+    assert "lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative" in loaded
+
+
 def test_task_catalog_and_camera_modes_need_no_mujoco():
     loaded = _modules_after(
         "import lerobot_tavis.envs.tasks.catalog, lerobot_tavis.envs.modes, lerobot_tavis.canonical")

@@ -119,6 +119,28 @@ def test_state_input_off_trains_from_a_copy_of_the_preset_without_the_state(tmp_
     assert refused.returncode == 2 and "STATE_INPUT must be on or off, got 'no'" in refused.stderr
 
 
+def test_hand_relative_actions_train_the_act_hand_relative_policy_from_a_copy_without_the_state(tmp_path):
+    shipped = preset_path("act_head_wrist_compact")
+    (train,) = [call for call in _run(tmp_path, "train", STATE_INPUT="off", ACTIONS="hand_relative",
+                                      PRESET_FILE=str(shipped)) if call.startswith("lerobot-train")]
+    copy = Path(re.search(r"--config_path=(\S+)", train)[1])
+    assert copy.name == "preset_act_head_wrist_compact_hand_relative.json"
+    expected = json.loads(shipped.read_text())
+    del expected["policy"]["input_features"]["observation.state"]
+    expected["policy"]["type"] = "act_hand_relative"
+    assert json.loads(copy.read_text()) == expected
+
+
+@pytest.mark.parametrize(("settings", "message"), [
+    (dict(ACTIONS="hand_relative"), "ACTIONS=hand_relative needs STATE_INPUT=off"),
+    (dict(ACTIONS="relative", STATE_INPUT="off"), "ACTIONS must be absolute or hand_relative, got 'relative'"),
+])
+def test_hand_relative_actions_with_the_state_input_or_unknown_actions_are_refused(tmp_path, settings, message):
+    refused = _stubbed(tmp_path, "train", **settings)
+    assert refused.returncode == 2 and message in refused.stderr
+    assert not (tmp_path / "calls.log").exists()
+
+
 def test_state_noise_trains_on_a_noisy_copy_made_once_with_the_training_seed(tmp_path):
     work = tmp_path / "work"
     dataset, copy = work / "dataset_head_wrist", work / "dataset_head_wrist_state_noise"

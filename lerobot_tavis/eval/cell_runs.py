@@ -41,6 +41,7 @@ from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.annotate import ANNOTATED_DIR, Annotator, episode_index
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
+from lerobot_tavis.policies import register_policy_types
 
 METRICS = ("successes", "sum_rewards", "max_rewards")  # per-episode lists of lerobot-eval's per-task metrics
 ENV_WORKER_NICENESS = 10  # env workers yield contended cores to the policy's process, use idle ones; same outcomes
@@ -157,8 +158,9 @@ def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
 def policy_config(cfg):
     """The checkpoint's policy config with the run's device and `--policy-option` fields set; an option the policy
     does not have is refused, naming it."""
-    import lerobot.policies  # noqa: F401  (registers the policy types that from_pretrained looks up)
     from lerobot.configs.policies import PreTrainedConfig
+
+    register_policy_types()
 
     try:
         policy = PreTrainedConfig.from_pretrained(cfg.policy_path)

@@ -1,0 +1,71 @@
+"""`act_hand_relative`: ACT trained on, and predicting, chunks whose arm poses are in the hand's frame.
+
+LeRobot's processors normalise absolute actions with the dataset's statistics. Around ACT's own network this policy
+turns a training chunk into the hand frame of the chunk's state (`lerobot_tavis.policies.hand_frame`) and normalises
+it with statistics of such chunks; a predicted chunk goes the other way, anchored on the state it was planned from,
+before ACT queues (or ensembles) it. So the queue holds absolute targets, and each is reached wherever the hand
+has moved meanwhile. The four statistics vectors are buffers, saved with the weights.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from lerobot.policies.act.modeling_act import ACTPolicy
+from lerobot.utils.constants import ACTION, OBS_STATE
+
+from lerobot_tavis import canonical
+from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import ACTHandRelativeConfig
+from lerobot_tavis.policies.act_hand_relative.statistics import hand_frame_statistics
+from lerobot_tavis.policies.hand_frame import from_hand_frame, to_hand_frame
+
+EPS = 1e-8  # as LeRobot's normaliser: (x - mean) / (std + eps)
+MIN_RELATIVE_STD = 1e-4  # m, or quaternion units (0.01 degree): a hand that never moves in the data is not scaled up
+
+
+class ACTHandRelativePolicy(ACTPolicy):
+    config_class = ACTHandRelativeConfig
+    name = "act_hand_relative"
+
+    def __init__(self, config: ACTHandRelativeConfig, dataset_stats: dict | None = None, dataset_meta=None,
+                 **kwargs):
+        """Built for training with the dataset's statistics (`dataset_stats`) and files (`dataset_meta.root`), as
+        LeRobot's `make_policy` passes them; `from_pretrained` builds it without and loads the saved buffers."""
+        super().__init__(config, **kwargs)
+        for buffer in ("absolute_mean", "absolute_std", "relative_mean", "relative_std"):
+            self.register_buffer(buffer, torch.full((canonical.ACTION_DIM,), float("nan")))
+        self._statistics_checked = False
+        if dataset_stats is not None and dataset_meta is not None:
+            relative_mean, relative_std = hand_frame_statistics(dataset_meta.root, config.chunk_size)
+            relative_std = np.maximum(relative_std, MIN_RELATIVE_STD)
+            for buffer, values in (("absolute_mean", dataset_stats[ACTION]["mean"]),
+                                   ("absolute_std", dataset_stats[ACTION]["std"]),
+                                   ("relative_mean", relative_mean), ("relative_std", relative_std)):
+                getattr(self, buffer).copy_(torch.as_tensor(np.asarray(values, dtype=np.float32)))
+
+    def forward(self, batch: dict[str, Tensor]) -> tuple[Tensor, dict]:
+        """ACT's loss on the chunk (normalised absolute actions in `batch`) rewritten in the hand frame."""
+        self._check_statistics()
+        absolute = batch[ACTION].float() * (self.absolute_std + EPS) + self.absolute_mean
+        relative = to_hand_frame(absolute, batch[OBS_STATE].float())
+        return super().forward({**batch, ACTION: (relative - self.relative_mean) / (self.relative_std + EPS)})
+
+    @torch.no_grad()
+    def predict_action_chunk(self, batch: dict[str, Tensor]) -> Tensor:
+        """A chunk of normalised absolute actions (B, chunk_size, 19), anchored on `batch`'s state; float32 whatever
+        precision the network ran in (a half-precision position would be off by a tenth of a millimetre)."""
+        self._check_statistics()
+        relative = super().predict_action_chunk(batch).float() * (self.relative_std + EPS) + self.relative_mean
+        absolute = from_hand_frame(relative, batch[OBS_STATE].float())
+        return (absolute - self.absolute_mean) / (self.absolute_std + EPS)
+
+    def _check_statistics(self) -> None:
+        if self._statistics_checked:
+            return
+        for buffer in ("absolute_mean", "absolute_std", "relative_mean", "relative_std"):
+            if not torch.isfinite(getattr(self, buffer)).all():
+                raise RuntimeError(f"act_hand_relative has no {buffer}: build it for training with the dataset "
+                                   "(LeRobot's make_policy(cfg, ds_meta=...)) or load a checkpoint that holds it")
+        self._statistics_checked = True

@@ -1,0 +1,196 @@
+"""`act_hand_relative`: ACT trained on hand-frame chunks and giving back absolute actions anchored on the state each
+chunk was planned from; its statistics, configuration checks, checkpoints and registration with LeRobot."""
+
+import os
+import subprocess
+import sys
+from types import SimpleNamespace
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+import torch
+from lerobot.configs.types import FeatureType, PolicyFeature
+from lerobot.policies.act.modeling_act import ACTPolicy
+from lerobot.utils.constants import ACTION, OBS_STATE
+
+from lerobot_tavis import canonical
+from lerobot_tavis.envs.transforms import matrix_from_quat, quat_multiply
+from lerobot_tavis.policies import register_policy_types
+from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import ACTHandRelativeConfig
+from lerobot_tavis.policies.act_hand_relative.modeling_act_hand_relative import EPS, ACTHandRelativePolicy
+from lerobot_tavis.policies.act_hand_relative.statistics import hand_frame_statistics
+from lerobot_tavis.policies.hand_frame import to_hand_frame
+
+CHUNK = 4
+IMAGE = "observation.images.head"
+
+
+def _episode(rng, length: int) -> tuple[np.ndarray, np.ndarray]:
+    """Actions and states (length, 19) of a made-up episode: hands drifting and turning, the state lagging."""
+    actions = np.tile(canonical.rest_action(), (length, 1))
+    for arm in canonical.ARMS:
+        actions[:, arm.position] += np.cumsum(rng.normal(scale=0.01, size=(length, 3)), axis=0)
+        turns = rng.normal(scale=0.05, size=(length, 4)) + actions[:, arm.quaternion]
+        actions[:, arm.quaternion] = turns / np.linalg.norm(turns, axis=1, keepdims=True)
+    states = np.concatenate([actions[:1], actions[:-1]]) + rng.normal(scale=1e-3, size=actions.shape)
+    return actions, states
+
+
+@pytest.fixture
+def dataset_root(tmp_path):
+    """A dataset's data files as LeRobot writes them (two files, episodes in either order) and its episodes."""
+    rng = np.random.default_rng(0)
+    episodes = [_episode(rng, length) for length in (9, 3, 6)]
+    for name, indices in (("file-000", [2, 0]), ("file-001", [1])):
+        rows = [(e, f, episodes[e][0][f], episodes[e][1][f]) for e in indices for f in range(len(episodes[e][0]))]
+        vectors = {key: pa.FixedSizeListArray.from_arrays(pa.array(np.concatenate([row[i] for row in rows]),
+                                                                   pa.float32()), canonical.ACTION_DIM)
+                   for i, key in ((2, "action"), (3, OBS_STATE))}
+        table = pa.table({"episode_index": [row[0] for row in rows], "frame_index": [row[1] for row in rows],
+                          **vectors})
+        (tmp_path / "data/chunk-000").mkdir(parents=True, exist_ok=True)
+        pq.write_table(table, tmp_path / f"data/chunk-000/{name}.parquet")
+    return tmp_path, [(a.astype(np.float32).astype(float), s.astype(np.float32).astype(float)) for a, s in episodes]
+
+
+def test_the_statistics_cover_every_chunk_action_inside_its_episode(dataset_root):
+    root, episodes = dataset_root
+    values = []
+    for actions, states in episodes:
+        for t in range(len(actions)):
+            for action in actions[t:t + CHUNK]:
+                relative = action.copy()
+                for arm in canonical.ARMS:
+                    hand = states[t, arm.quaternion] / np.linalg.norm(states[t, arm.quaternion])  # made-up: not unit
+                    relative[arm.position] = matrix_from_quat(hand).T @ (action[arm.position] - states[t, arm.position])
+                    turn = quat_multiply(hand * [1, -1, -1, -1], action[arm.quaternion])
+                    relative[arm.quaternion] = turn * np.sign(turn[0])
+                values.append(relative)
+    assert len(values) == sum(min(CHUNK, n - t) for n in (9, 3, 6) for t in range(n))
+    mean, std = hand_frame_statistics(root, CHUNK)
+    np.testing.assert_allclose(mean, np.mean(values, axis=0), atol=1e-9)
+    np.testing.assert_allclose(std, np.std(values, axis=0), atol=1e-9)
+
+
+def _config(**fields) -> ACTHandRelativeConfig:
+    inputs = {IMAGE: PolicyFeature(FeatureType.VISUAL, (3, 32, 32)), **fields.pop("inputs", {})}
+    return ACTHandRelativeConfig(
+        input_features=inputs, output_features={ACTION: PolicyFeature(FeatureType.ACTION, (19,))},
+        chunk_size=CHUNK, n_action_steps=CHUNK, dim_model=32, n_heads=2, dim_feedforward=64, n_encoder_layers=1,
+        n_decoder_layers=1, latent_dim=8, pretrained_backbone_weights=None, device="cpu", **fields)
+
+
+@pytest.fixture
+def policy(dataset_root):
+    root, episodes = dataset_root
+    actions = np.concatenate([a for a, _ in episodes])
+    stats = {ACTION: {"mean": actions.mean(axis=0), "std": actions.std(axis=0)}}
+    torch.manual_seed(0)
+    return ACTHandRelativePolicy(_config(), dataset_stats=stats, dataset_meta=SimpleNamespace(root=root))
+
+
+def _batch(rng, policy, size: int) -> dict:
+    absolute = torch.tensor(np.stack([_episode(rng, CHUNK)[0] for _ in range(size)]), dtype=torch.float32)
+    return {IMAGE: torch.rand(size, 3, 32, 32),
+            OBS_STATE: torch.tensor(np.stack([_episode(rng, 1)[1][0] for _ in range(size)]), dtype=torch.float32),
+            ACTION: (absolute - policy.absolute_mean) / (policy.absolute_std + EPS),
+            "action_is_pad": torch.zeros(size, CHUNK, dtype=torch.bool)}, absolute
+
+
+def test_training_sees_the_chunk_in_the_hand_frame_normalised_by_its_statistics(policy, monkeypatch):
+    batch, absolute = _batch(np.random.default_rng(1), policy, 3)
+    loss, _ = policy.forward(batch)
+    loss.backward()
+    assert torch.isfinite(loss) and policy.model.action_head.weight.grad.abs().sum() > 0
+    seen = {}
+    monkeypatch.setattr(ACTPolicy, "forward", lambda self, batch: seen.update(batch) or (torch.zeros(()), {}))
+    policy.forward(batch)
+    expected = (to_hand_frame(absolute, batch[OBS_STATE]) - policy.relative_mean) / (policy.relative_std + EPS)
+    torch.testing.assert_close(seen[ACTION], expected, atol=1e-4, rtol=0)
+    assert seen[IMAGE] is batch[IMAGE]
+
+
+def test_a_predicted_chunk_comes_back_absolute_anchored_on_the_state_it_was_planned_from(policy, monkeypatch):
+    batch, absolute = _batch(np.random.default_rng(2), policy, 2)
+    planned_from = batch[OBS_STATE]
+    network_output = (to_hand_frame(absolute, planned_from) - policy.relative_mean) / (policy.relative_std + EPS)
+    monkeypatch.setattr(ACTPolicy, "predict_action_chunk", lambda self, batch: network_output)
+    moved = {**batch, OBS_STATE: planned_from + 0.05}  # the hands have moved by the next step
+    policy.reset()
+    executed = torch.stack([policy.select_action(step) for step in (batch, moved, moved, moved)], dim=1)
+    executed = executed * (policy.absolute_std + EPS) + policy.absolute_mean
+    for arm in canonical.ARMS:
+        torch.testing.assert_close(executed[..., arm.position], absolute[..., arm.position], atol=1e-5, rtol=0)
+        alignment = (executed[..., arm.quaternion] * absolute[..., arm.quaternion]).sum(-1).abs()
+        torch.testing.assert_close(alignment, torch.ones_like(alignment), atol=1e-5, rtol=0)
+    torch.testing.assert_close(executed[..., 14:], absolute[..., 14:], atol=1e-5, rtol=0)
+
+
+def test_the_state_as_a_network_input_or_another_action_is_refused():
+    state = {OBS_STATE: PolicyFeature(FeatureType.STATE, (19,))}
+    with pytest.raises(ValueError, match="remove observation.state from policy.input_features"):
+        ACTHandRelativePolicy(_config(inputs=state))
+    config = _config()
+    config.output_features = {ACTION: PolicyFeature(FeatureType.ACTION, (14,))}
+    with pytest.raises(ValueError, match="needs TAVIS's 19-D canonical action, got \\(14,\\)"):
+        ACTHandRelativePolicy(config)
+
+
+def test_without_the_dataset_statistics_it_refuses_to_act():
+    policy = ACTHandRelativePolicy(_config())
+    with pytest.raises(RuntimeError, match="act_hand_relative has no absolute_mean"):
+        policy.predict_action_chunk({IMAGE: torch.rand(1, 3, 32, 32), OBS_STATE: torch.zeros(1, 19)})
+
+
+def test_a_checkpoint_keeps_the_statistics_and_lerobot_finds_the_policy_and_its_processors(policy, tmp_path):
+    from lerobot.configs.policies import PreTrainedConfig
+    from lerobot.policies.factory import get_policy_class, make_pre_post_processors
+
+    policy.save_pretrained(tmp_path)
+    register_policy_types()
+    config = PreTrainedConfig.from_pretrained(tmp_path)
+    assert type(config) is ACTHandRelativeConfig and get_policy_class(config.type) is ACTHandRelativePolicy
+    loaded = ACTHandRelativePolicy.from_pretrained(tmp_path, config=config)
+    for buffer in ("absolute_mean", "absolute_std", "relative_mean", "relative_std"):
+        torch.testing.assert_close(getattr(loaded, buffer), getattr(policy, buffer))
+    stats = {ACTION: {"mean": policy.absolute_mean.numpy(), "std": policy.absolute_std.numpy()}}
+    preprocessor, postprocessor = make_pre_post_processors(config, dataset_stats=stats)
+    raw_state = torch.rand(1, 19)
+    processed = preprocessor({IMAGE: torch.rand(1, 3, 32, 32), OBS_STATE: raw_state})
+    torch.testing.assert_close(processed[OBS_STATE], raw_state)  # the anchor reaches the policy un-normalised
+
+
+def test_lerobot_train_trains_it_and_the_checkpoint_acts_on_the_env(tmp_path):
+    """The CLI path: the plugin module registers the type for lerobot-train, and a checkpoint drives the env."""
+    import json
+
+    from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+    from lerobot_tavis.dataset_tools.record import RecordConfig, record
+    from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.policy_configs import preset_path
+    from lerobot_tavis.viewer import PolicyDriver
+
+    record(RecordConfig(out_dir=tmp_path / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
+           progress=False)
+    root = convert(ConvertConfig(tmp_path / "raw", "local/tiny", tmp_path / "dataset", image_size=(120, 160),
+                                 cameras=("head", "left_wrist", "right_wrist")), progress=False)
+    preset = json.loads(preset_path("act_head_wrist_compact").read_text())
+    del preset["policy"]["input_features"][OBS_STATE]
+    preset["policy"]["type"] = "act_hand_relative"
+    (tmp_path / "preset.json").write_text(json.dumps(preset))
+    train = ["lerobot-train", f"--config_path={tmp_path / 'preset.json'}", "--dataset.repo_id=local/tiny",
+             f"--dataset.root={root}", "--env.task=conditional_pick", "--policy.device=cpu", "--steps=1",
+             "--save_freq=1", "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}"]
+    bin_dir = os.path.dirname(sys.executable)
+    subprocess.run(train, check=True, capture_output=True, timeout=600,
+                   env={**os.environ, "MUJOCO_GL": "egl", "PATH": f"{bin_dir}:{os.environ['PATH']}"})
+    driver = PolicyDriver(tmp_path / "train/checkpoints/last/pretrained_model")
+    assert type(driver.policy) is ACTHandRelativePolicy
+    env = TavisEnv("conditional_pick", "gr1t2", camera_mode="head_wrist", image_size=(120, 160))
+    observation, _ = env.reset(seed=0)
+    driver.reset()
+    action = driver.act(observation, env.task_description)
+    env.close()
+    assert action.shape == (19,) and np.all(np.isfinite(action))
