@@ -1,6 +1,6 @@
 """Policy presets: they parse with LeRobot's loader, match a converted dataset and the env, a diffusion preset
 trains, evaluates periodically on the tavis env and leaves a checkpoint that lerobot-eval runs, and a compact ACT
-without the state input trains and runs in `tavis eval`."""
+without the state input (absolute or hand-frame actions) trains and runs in `tavis eval`."""
 
 import json
 import os
@@ -134,10 +134,13 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
     assert info["overall"]["n_episodes"] == 1
 
 
-def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path):
-    """benchmarks/train_baseline.sh's STATE_INPUT=off: the preset's inputs less observation.state."""
+@pytest.mark.parametrize("policy_type", ["act", "act_hand_relative"])
+def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, policy_type):
+    """benchmarks/train_baseline.sh's STATE_INPUT=off: the preset's inputs less observation.state; with
+    ACTIONS=hand_relative the policy type this package registers, which lerobot-train finds through the plugin."""
     preset = json.loads(preset_path("act_head_wrist_compact").read_text())
     del preset["policy"]["input_features"]["observation.state"]
+    preset["policy"]["type"] = policy_type
     for feature in preset["policy"]["input_features"].values():
         feature["shape"] = [3, *TINY]
     (tmp_path / "preset.json").write_text(json.dumps(preset))
@@ -148,7 +151,8 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
              "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}"]
     subprocess.run(train, check=True, capture_output=True, env=env, timeout=600)
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
-    assert "observation.state" not in json.loads((checkpoint / "config.json").read_text())["input_features"]
+    config = json.loads((checkpoint / "config.json").read_text())
+    assert config["type"] == policy_type and "observation.state" not in config["input_features"]
     evaluate = [sys.executable, "-m", "lerobot_tavis.cli", "eval", "--policy", str(checkpoint), "--device", "cpu",
                 "--tasks", "conditional_pick", "--splits", "id", "--episodes", "1", "--workers", "1",
                 "--batch-size", "1", "--episode-length-s", "1", "--film-episodes", "0", "--out", str(tmp_path / "eval")]

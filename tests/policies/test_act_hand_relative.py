@@ -1,9 +1,7 @@
 """`act_hand_relative`: ACT trained on hand-frame chunks and giving back absolute actions anchored on the state each
-chunk was planned from; its statistics, configuration checks, checkpoints and registration with LeRobot."""
+chunk was planned from; its statistics, configuration checks, checkpoints and registration with LeRobot (the
+lerobot-train and `tavis eval` path: tests/test_policy_configs.py)."""
 
-import os
-import subprocess
-import sys
 from types import SimpleNamespace
 
 import numpy as np
@@ -160,37 +158,3 @@ def test_a_checkpoint_keeps_the_statistics_and_lerobot_finds_the_policy_and_its_
     raw_state = torch.rand(1, 19)
     processed = preprocessor({IMAGE: torch.rand(1, 3, 32, 32), OBS_STATE: raw_state})
     torch.testing.assert_close(processed[OBS_STATE], raw_state)  # the anchor reaches the policy un-normalised
-
-
-def test_lerobot_train_trains_it_and_the_checkpoint_acts_on_the_env(tmp_path):
-    """The CLI path: the plugin module registers the type for lerobot-train, and a checkpoint drives the env."""
-    import json
-
-    from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
-    from lerobot_tavis.dataset_tools.record import RecordConfig, record
-    from lerobot_tavis.envs.env import TavisEnv
-    from lerobot_tavis.policy_configs import preset_path
-    from lerobot_tavis.viewer import PolicyDriver
-
-    record(RecordConfig(out_dir=tmp_path / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
-           progress=False)
-    root = convert(ConvertConfig(tmp_path / "raw", "local/tiny", tmp_path / "dataset", image_size=(120, 160),
-                                 cameras=("head", "left_wrist", "right_wrist")), progress=False)
-    preset = json.loads(preset_path("act_head_wrist_compact").read_text())
-    del preset["policy"]["input_features"][OBS_STATE]
-    preset["policy"]["type"] = "act_hand_relative"
-    (tmp_path / "preset.json").write_text(json.dumps(preset))
-    train = ["lerobot-train", f"--config_path={tmp_path / 'preset.json'}", "--dataset.repo_id=local/tiny",
-             f"--dataset.root={root}", "--env.task=conditional_pick", "--policy.device=cpu", "--steps=1",
-             "--save_freq=1", "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}"]
-    bin_dir = os.path.dirname(sys.executable)
-    subprocess.run(train, check=True, capture_output=True, timeout=600,
-                   env={**os.environ, "MUJOCO_GL": "egl", "PATH": f"{bin_dir}:{os.environ['PATH']}"})
-    driver = PolicyDriver(tmp_path / "train/checkpoints/last/pretrained_model")
-    assert type(driver.policy) is ACTHandRelativePolicy
-    env = TavisEnv("conditional_pick", "gr1t2", camera_mode="head_wrist", image_size=(120, 160))
-    observation, _ = env.reset(seed=0)
-    driver.reset()
-    action = driver.act(observation, env.task_description)
-    env.close()
-    assert action.shape == (19,) and np.all(np.isfinite(action))
