@@ -74,10 +74,11 @@ def test_the_statistics_cover_every_chunk_action_inside_its_episode(dataset_root
 
 def _config(**fields) -> ACTHandRelativeConfig:
     inputs = {IMAGE: PolicyFeature(FeatureType.VISUAL, (3, 32, 32)), **fields.pop("inputs", {})}
-    return ACTHandRelativeConfig(
-        input_features=inputs, output_features={ACTION: PolicyFeature(FeatureType.ACTION, (19,))},
-        chunk_size=CHUNK, n_action_steps=CHUNK, dim_model=32, n_heads=2, dim_feedforward=64, n_encoder_layers=1,
-        n_decoder_layers=1, latent_dim=8, pretrained_backbone_weights=None, device="cpu", **fields)
+    small = dict(chunk_size=CHUNK, n_action_steps=CHUNK, dim_model=32, n_heads=2, dim_feedforward=64,
+                 n_encoder_layers=1, n_decoder_layers=1, latent_dim=8, pretrained_backbone_weights=None, device="cpu")
+    return ACTHandRelativeConfig(input_features=inputs,
+                                 output_features={ACTION: PolicyFeature(FeatureType.ACTION, (19,))},
+                                 **(small | fields))
 
 
 @pytest.fixture
@@ -124,6 +125,30 @@ def test_a_predicted_chunk_comes_back_absolute_anchored_on_the_state_it_was_plan
         alignment = (executed[..., arm.quaternion] * absolute[..., arm.quaternion]).sum(-1).abs()
         torch.testing.assert_close(alignment, torch.ones_like(alignment), atol=1e-5, rtol=0)
     torch.testing.assert_close(executed[..., 14:], absolute[..., 14:], atol=1e-5, rtol=0)
+
+
+def test_temporal_ensembling_averages_chunks_planned_from_different_states_as_absolute_targets(dataset_root,
+                                                                                               monkeypatch):
+    root, _ = dataset_root
+    stats = {ACTION: {"mean": np.zeros(19), "std": np.ones(19)}}
+    policy = ACTHandRelativePolicy(_config(temporal_ensemble_coeff=0.01, n_action_steps=1), dataset_stats=stats,
+                                   dataset_meta=SimpleNamespace(root=root))
+    rng = np.random.default_rng(3)
+    targets = torch.tensor(_episode(rng, 2 * CHUNK)[0], dtype=torch.float32).unsqueeze(0)  # (1, 8, 19)
+    states = torch.tensor(_episode(rng, CHUNK)[1], dtype=torch.float32)  # a different hand pose at each step
+    step = iter(range(CHUNK))
+
+    def planned(self, batch):  # the chunk from this step on, in the hand frame of this step's state
+        i = next(step)
+        return (to_hand_frame(targets[:, i:i + CHUNK], batch[OBS_STATE]) - policy.relative_mean) / (
+            policy.relative_std + EPS)
+
+    monkeypatch.setattr(ACTPolicy, "predict_action_chunk", planned)
+    policy.reset()
+    executed = torch.stack([policy.select_action({IMAGE: torch.rand(1, 3, 32, 32), OBS_STATE: state[None]})
+                            for state in states], dim=1)
+    for arm in canonical.ARMS:
+        torch.testing.assert_close(executed[..., arm.position], targets[:, :CHUNK, arm.position], atol=1e-5, rtol=0)
 
 
 def test_the_state_as_a_network_input_or_another_action_is_refused():
