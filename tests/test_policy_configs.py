@@ -134,13 +134,16 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
     assert info["overall"]["n_episodes"] == 1
 
 
-@pytest.mark.parametrize("policy_type", ["act", "act_hand_relative"])
-def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, policy_type):
+@pytest.mark.parametrize(("policy_type", "extra"), [("act", {}), ("act_hand_relative", {}),
+                                                    ("act_hand_relative", {"time_input": True})])
+def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, policy_type,
+                                                                             extra):
     """benchmarks/train_baseline.sh's STATE_INPUT=off: the preset's inputs less observation.state; with
-    ACTIONS=hand_relative the policy type this package registers, which lerobot-train finds through the plugin."""
+    ACTIONS=hand_relative the policy type this package registers, which lerobot-train finds through the plugin, and
+    with its time input (a feature no dataset holds)."""
     preset = json.loads(preset_path("act_head_wrist_compact").read_text())
     del preset["policy"]["input_features"]["observation.state"]
-    preset["policy"]["type"] = policy_type
+    preset["policy"] |= {"type": policy_type, **extra}
     for feature in preset["policy"]["input_features"].values():
         feature["shape"] = [3, *TINY]
     (tmp_path / "preset.json").write_text(json.dumps(preset))

@@ -11,7 +11,7 @@ import pytest
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.policies.act.modeling_act import ACTPolicy
-from lerobot.utils.constants import ACTION, OBS_STATE
+from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_STATE
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.transforms import matrix_from_quat, quat_multiply
@@ -87,7 +87,7 @@ def policy(dataset_root):
     actions = np.concatenate([a for a, _ in episodes])
     stats = {ACTION: {"mean": actions.mean(axis=0), "std": actions.std(axis=0)}}
     torch.manual_seed(0)
-    return ACTHandRelativePolicy(_config(), dataset_stats=stats, dataset_meta=SimpleNamespace(root=root))
+    return ACTHandRelativePolicy(_config(), dataset_stats=stats, dataset_meta=SimpleNamespace(root=root, fps=20))
 
 
 def _batch(rng, policy, size: int) -> dict:
@@ -132,7 +132,7 @@ def test_temporal_ensembling_averages_chunks_planned_from_different_states_as_ab
     root, _ = dataset_root
     stats = {ACTION: {"mean": np.zeros(19), "std": np.ones(19)}}
     policy = ACTHandRelativePolicy(_config(temporal_ensemble_coeff=0.01, n_action_steps=1), dataset_stats=stats,
-                                   dataset_meta=SimpleNamespace(root=root))
+                                   dataset_meta=SimpleNamespace(root=root, fps=20))
     rng = np.random.default_rng(3)
     targets = torch.tensor(_episode(rng, 2 * CHUNK)[0], dtype=torch.float32).unsqueeze(0)  # (1, 8, 19)
     states = torch.tensor(_episode(rng, CHUNK)[1], dtype=torch.float32)  # a different hand pose at each step
@@ -149,6 +149,50 @@ def test_temporal_ensembling_averages_chunks_planned_from_different_states_as_ab
                             for state in states], dim=1)
     for arm in canonical.ARMS:
         torch.testing.assert_close(executed[..., arm.position], targets[:, :CHUNK, arm.position], atol=1e-5, rtol=0)
+
+
+def test_the_time_input_is_the_timestamp_in_training_and_the_steps_since_reset_when_acting(dataset_root,
+                                                                                            monkeypatch):
+    root, episodes = dataset_root
+    actions = np.concatenate([a for a, _ in episodes])
+    stats = {ACTION: {"mean": actions.mean(axis=0), "std": actions.std(axis=0)}}
+    torch.manual_seed(0)
+    policy = ACTHandRelativePolicy(_config(time_input=True, n_action_steps=2), dataset_stats=stats,
+                                   dataset_meta=SimpleNamespace(root=root, fps=10))
+    assert policy.config.input_features[OBS_ENV_STATE] == PolicyFeature(FeatureType.ENV, (1,))
+    assert policy.config.fps == 10.0  # the dataset's
+    batch, _ = _batch(np.random.default_rng(4), policy, 3)
+    observation = {IMAGE: batch[IMAGE][:1], OBS_STATE: batch[OBS_STATE][:1]}
+    policy.reset()
+    early = policy.predict_action_chunk(observation)
+    for _ in range(50):
+        policy.select_action(observation)
+    late = policy.predict_action_chunk(observation)
+    assert not torch.allclose(early, late)  # the network reads the time
+    loss, _ = policy.forward({**batch, "timestamp": torch.tensor([0.0, 1.5, 9.0])})
+    assert torch.isfinite(loss)
+
+    seen = []
+    monkeypatch.setattr(ACTPolicy, "forward", lambda self, batch: seen.append(batch) or (torch.zeros(()), {}))
+    policy.forward({**batch, "timestamp": torch.tensor([0.0, 1.5, 9.0])})
+    torch.testing.assert_close(seen[-1][OBS_ENV_STATE], torch.tensor([[0.0], [0.15], [0.9]]))
+    monkeypatch.setattr(ACTPolicy, "predict_action_chunk",
+                        lambda self, batch: seen.append(batch) or torch.zeros(1, CHUNK, 19))
+    seen.clear()
+    policy.reset()
+    for _ in range(5):
+        policy.select_action(observation)
+    policy.reset()
+    policy.select_action(observation)
+    # chunks planned at steps 0, 2 and 4 (two executed per chunk) at 10 steps per second, then again from 0
+    assert [float(planned[OBS_ENV_STATE]) * 10.0 for planned in seen] == pytest.approx([0.0, 0.2, 0.4, 0.0])
+
+
+@pytest.mark.parametrize(("time_input", "shape"), [(False, (1,)), (True, (2,))])
+def test_an_environment_state_other_than_the_time_input_is_refused(time_input, shape):
+    with pytest.raises(ValueError, match="observation.environment_state is its time input"):
+        ACTHandRelativePolicy(_config(time_input=time_input,
+                                      inputs={OBS_ENV_STATE: PolicyFeature(FeatureType.ENV, shape)}))
 
 
 def test_the_state_as_a_network_input_or_another_action_is_refused():

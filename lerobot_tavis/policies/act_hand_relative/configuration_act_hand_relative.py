@@ -1,12 +1,13 @@
-"""Configuration of `act_hand_relative`: ACT's, with two more requirements on its features."""
+"""Configuration of `act_hand_relative`: ACT's, with requirements on its features and an optional time input."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from lerobot.configs.policies import PreTrainedConfig
+from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.policies.act.configuration_act import ACTConfig
-from lerobot.utils.constants import ACTION, OBS_STATE
+from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_STATE
 
 from lerobot_tavis import canonical
 
@@ -20,13 +21,28 @@ class ACTHandRelativeConfig(ACTConfig):
     `input_features` (the processors then pass it through un-normalised). The action is TAVIS's canonical 19-D
     vector. Every ACT option keeps its meaning, temporal ensembling included (chunks are turned back into absolute
     actions before they are queued or ensembled).
+
+    `time_input`: the seconds since the episode began as one more encoder input, ACT's `observation.environment_state`
+    (added to `input_features`; the dataset's `timestamp` in training, `fps` steps per second counted since `reset()`
+    when acting). It tells apart moments whose images are the same, such as the start of an episode while the
+    demonstrator looks at what the policy's cameras do not show.
     """
 
+    time_input: bool = False
+    fps: float = 20.0  # policy steps per second when acting (TAVIS's rate, envs.physics.POLICY_HZ); training sets
+    # the dataset's
+
     def validate_features(self) -> None:
+        if self.time_input:
+            self.input_features.setdefault(OBS_ENV_STATE, PolicyFeature(FeatureType.ENV, (1,)))
         super().validate_features()
         if OBS_STATE in self.input_features:
             raise ValueError(f"act_hand_relative reads {OBS_STATE} only to anchor its chunks and does not feed it to "
                              f"the network: remove {OBS_STATE} from policy.input_features")
+        time = self.input_features.get(OBS_ENV_STATE)
+        if time is not None and not (self.time_input and tuple(time.shape) == (1,)):
+            raise ValueError(f"act_hand_relative's {OBS_ENV_STATE} is its time input, one value (shape (1,)) with "
+                             f"time_input=true; got shape {tuple(time.shape)} with time_input={self.time_input}")
         action = self.output_features.get(ACTION)
         if action is None or tuple(action.shape) != (canonical.ACTION_DIM,):
             raise ValueError(f"act_hand_relative needs TAVIS's {canonical.ACTION_DIM}-D canonical {ACTION}, got "

@@ -14,7 +14,7 @@ import torch
 from torch import Tensor
 
 from lerobot.policies.act.modeling_act import ACTPolicy
-from lerobot.utils.constants import ACTION, OBS_STATE
+from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_STATE
 
 from lerobot_tavis import canonical
 from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import ACTHandRelativeConfig
@@ -22,6 +22,7 @@ from lerobot_tavis.policies.act_hand_relative.statistics import hand_frame_stati
 from lerobot_tavis.policies.hand_frame import from_hand_frame, to_hand_frame
 
 EPS = 1e-8  # as LeRobot's normaliser: (x - mean) / (std + eps)
+TIME_SCALE_S = 10.0  # the time input is elapsed seconds over this, about 0-2 over a TAVIS episode
 MIN_RELATIVE_STD = 1e-4  # m, or quaternion units (0.01 degree): a hand that never moves in the data is not scaled up
 
 
@@ -37,6 +38,8 @@ class ACTHandRelativePolicy(ACTPolicy):
         for buffer in ("absolute_mean", "absolute_std", "relative_mean", "relative_std"):
             self.register_buffer(buffer, torch.full((canonical.ACTION_DIM,), float("nan")))
         self._statistics_checked = False
+        if dataset_meta is not None:
+            config.fps = float(dataset_meta.fps)
         if dataset_stats is not None and dataset_meta is not None:
             relative_mean, relative_std = hand_frame_statistics(dataset_meta.root, config.chunk_size)
             relative_std = np.maximum(relative_std, MIN_RELATIVE_STD)
@@ -45,21 +48,45 @@ class ACTHandRelativePolicy(ACTPolicy):
                                    ("relative_mean", relative_mean), ("relative_std", relative_std)):
                 getattr(self, buffer).copy_(torch.as_tensor(np.asarray(values, dtype=np.float32)))
 
+    def reset(self):
+        """Called at the start of every episode: the time input counts from here."""
+        super().reset()
+        self._elapsed_steps = 0
+
     def forward(self, batch: dict[str, Tensor]) -> tuple[Tensor, dict]:
         """ACT's loss on the chunk (normalised absolute actions in `batch`) rewritten in the hand frame."""
         self._check_statistics()
         absolute = batch[ACTION].float() * (self.absolute_std + EPS) + self.absolute_mean
         relative = to_hand_frame(absolute, batch[OBS_STATE].float())
-        return super().forward({**batch, ACTION: (relative - self.relative_mean) / (self.relative_std + EPS)})
+        batch = {**batch, ACTION: (relative - self.relative_mean) / (self.relative_std + EPS)}
+        if self.config.time_input:
+            batch[OBS_ENV_STATE] = self._time_token(batch["timestamp"], batch[ACTION])
+        return super().forward(batch)
+
+    @torch.no_grad()
+    def select_action(self, batch: dict[str, Tensor]) -> Tensor:
+        action = super().select_action(batch)
+        self._elapsed_steps += 1
+        return action
 
     @torch.no_grad()
     def predict_action_chunk(self, batch: dict[str, Tensor]) -> Tensor:
         """A chunk of normalised absolute actions (B, chunk_size, 19), anchored on `batch`'s state; float32 whatever
-        precision the network ran in (a half-precision position would be off by a tenth of a millimetre)."""
+        precision the network ran in (a half-precision position would be off by a tenth of a millimetre). The time
+        input, if any, is the steps `select_action` has taken since `reset()` over `config.fps`."""
         self._check_statistics()
+        if self.config.time_input:
+            state = batch[OBS_STATE]
+            elapsed_s = torch.full(state.shape[:1], self._elapsed_steps / self.config.fps)
+            batch = {**batch, OBS_ENV_STATE: self._time_token(elapsed_s, state)}
         relative = super().predict_action_chunk(batch).float() * (self.relative_std + EPS) + self.relative_mean
         absolute = from_hand_frame(relative, batch[OBS_STATE].float())
         return (absolute - self.absolute_mean) / (self.absolute_std + EPS)
+
+    @staticmethod
+    def _time_token(elapsed_s: Tensor, like: Tensor) -> Tensor:
+        """The time input (B, 1) from seconds since the episode began (B,), on `like`'s device, float32."""
+        return (elapsed_s.to(device=like.device, dtype=torch.float32) / TIME_SCALE_S).unsqueeze(-1)
 
     def _check_statistics(self) -> None:
         if self._statistics_checked:
