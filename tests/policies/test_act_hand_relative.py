@@ -81,16 +81,21 @@ def _config(**fields) -> ACTHandRelativeConfig:
                                  **(small | fields))
 
 
+def _action_stats(episodes) -> dict:
+    actions = np.concatenate([a for a, _ in episodes])
+    return {ACTION: {"mean": actions.mean(axis=0), "std": actions.std(axis=0)}}
+
+
 @pytest.fixture
 def policy(dataset_root):
     root, episodes = dataset_root
-    actions = np.concatenate([a for a, _ in episodes])
-    stats = {ACTION: {"mean": actions.mean(axis=0), "std": actions.std(axis=0)}}
     torch.manual_seed(0)
-    return ACTHandRelativePolicy(_config(), dataset_stats=stats, dataset_meta=SimpleNamespace(root=root, fps=20))
+    return ACTHandRelativePolicy(_config(), dataset_stats=_action_stats(episodes),
+                                 dataset_meta=SimpleNamespace(root=root, fps=20))
 
 
-def _batch(rng, policy, size: int) -> dict:
+def _batch(rng, policy, size: int) -> tuple[dict, torch.Tensor]:
+    """A training batch of `size` made-up chunks (normalised as LeRobot's processors do) and its absolute chunks."""
     absolute = torch.tensor(np.stack([_episode(rng, CHUNK)[0] for _ in range(size)]), dtype=torch.float32)
     return {IMAGE: torch.rand(size, 3, 32, 32),
             OBS_STATE: torch.tensor(np.stack([_episode(rng, 1)[1][0] for _ in range(size)]), dtype=torch.float32),
@@ -154,10 +159,8 @@ def test_temporal_ensembling_averages_chunks_planned_from_different_states_as_ab
 def test_the_time_input_is_the_timestamp_in_training_and_the_steps_since_reset_when_acting(dataset_root,
                                                                                             monkeypatch):
     root, episodes = dataset_root
-    actions = np.concatenate([a for a, _ in episodes])
-    stats = {ACTION: {"mean": actions.mean(axis=0), "std": actions.std(axis=0)}}
     torch.manual_seed(0)
-    policy = ACTHandRelativePolicy(_config(time_input=True, n_action_steps=2), dataset_stats=stats,
+    policy = ACTHandRelativePolicy(_config(time_input=True, n_action_steps=2), dataset_stats=_action_stats(episodes),
                                    dataset_meta=SimpleNamespace(root=root, fps=10))
     assert policy.config.input_features[OBS_ENV_STATE] == PolicyFeature(FeatureType.ENV, (1,))
     assert policy.config.fps == 10.0  # the dataset's
