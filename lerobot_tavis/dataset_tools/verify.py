@@ -21,6 +21,7 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG
+from lerobot_tavis.dataset_tools.frames import column_array, episode_frames
 from lerobot_tavis.errors import TavisError
 
 TOLERANCE_M = 0.015  # replayed hands stay within 1.3 cm of a 60 Hz recording at 20 Hz (measured, 20 episodes)
@@ -63,15 +64,10 @@ def verify_dataset(root: Path, episodes: Sequence[int] | None = None, hold_s: fl
 
 
 def _episode_columns(root: Path) -> dict[int, dict[str, np.ndarray]]:
-    """Per episode index: its frames' state, action and split, in frame order (read from the parquet files)."""
-    import pandas as pd
-
-    table = pd.concat([pd.read_parquet(path) for path in sorted((Path(root) / "data").rglob("*.parquet"))])
-    table = table.sort_values(["episode_index", "frame_index"])
-    return {int(index): {"state": np.stack(rows[ft.STATE_KEY].to_numpy()),
-                         "action": np.stack(rows[ft.ACTION_KEY].to_numpy()),
-                         "split": str(rows[ft.SPLIT_KEY].iloc[0])}
-            for index, rows in table.groupby("episode_index")}
+    """Per episode index: its frames' state, action and split, in frame order."""
+    return {index: {"state": column_array(rows, ft.STATE_KEY), "action": column_array(rows, ft.ACTION_KEY),
+                    "split": str(rows[ft.SPLIT_KEY].iloc[0])}
+            for index, rows in episode_frames(root).items()}
 
 
 def _replay(robot: str, fps: int, entry: dict, columns: dict, zero_neck: bool, hold_s: float,

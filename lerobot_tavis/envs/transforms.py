@@ -38,8 +38,7 @@ def quat_multiply(a, b) -> np.ndarray:
 
 def quat_angle_rad(a, b) -> float:
     """Angle of the rotation between two orientations, in [0, pi]."""
-    dot = abs(float(np.dot(a, b)) / (np.linalg.norm(a) * np.linalg.norm(b)))
-    return 2.0 * float(np.arccos(min(1.0, dot)))
+    return float(quat_angles_rad(np.asarray(a, dtype=float), np.asarray(b, dtype=float)))
 
 
 def quat_angles_rad(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:

@@ -23,6 +23,7 @@ from lerobot_tavis.policies.hand_frame import from_hand_frame, to_hand_frame
 
 EPS = 1e-8  # as LeRobot's normaliser: (x - mean) / (std + eps)
 TIME_SCALE_S = 10.0  # the time input is elapsed seconds over this, about 0-2 over a TAVIS episode
+STATISTICS = ("absolute_mean", "absolute_std", "relative_mean", "relative_std")  # buffers, saved with the weights
 MIN_RELATIVE_STD = 1e-4  # m, or quaternion units (0.01 degree): a hand that never moves in the data is not scaled up
 
 
@@ -35,7 +36,7 @@ class ACTHandRelativePolicy(ACTPolicy):
         """Built for training with the dataset's statistics (`dataset_stats`) and files (`dataset_meta.root`), as
         LeRobot's `make_policy` passes them; `from_pretrained` builds it without and loads the saved buffers."""
         super().__init__(config, **kwargs)
-        for buffer in ("absolute_mean", "absolute_std", "relative_mean", "relative_std"):
+        for buffer in STATISTICS:
             self.register_buffer(buffer, torch.full((canonical.ACTION_DIM,), float("nan")))
         self._statistics_checked = False
         if dataset_meta is not None:
@@ -91,7 +92,7 @@ class ACTHandRelativePolicy(ACTPolicy):
     def _check_statistics(self) -> None:
         if self._statistics_checked:
             return
-        for buffer in ("absolute_mean", "absolute_std", "relative_mean", "relative_std"):
+        for buffer in STATISTICS:
             if not torch.isfinite(getattr(self, buffer)).all():
                 raise RuntimeError(f"act_hand_relative has no {buffer}: build it for training with the dataset "
                                    "(LeRobot's make_policy(cfg, ds_meta=...)) or load a checkpoint that holds it")
