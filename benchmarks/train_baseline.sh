@@ -14,21 +14,23 @@
 # `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1" for
 # ACT's temporal ensembling), TRAIN_OPTIONS (more lerobot-train arguments, e.g. "--policy.chunk_size=40
 # --policy.n_action_steps=20"), EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), CHECKPOINTS (which
-# `eval` takes: all, last, or one training step such as 1600), STATE_INPUT (on; off: the policy sees its cameras alone, a copy of the preset without
-# the observation.state input written to WORK, to tell a policy that copies its own pose from one that needs it),
+# `eval` takes: all, last, or one training step such as 1600), STATE_INPUT (on; off: the policy sees its cameras
+# alone, a copy of the preset without the observation.state input written to WORK, to tell a policy that copies its
+# own pose from one that needs it; off is the default with ACTIONS=hand_relative and the only value it takes),
 # STATE_NOISE (empty: off; POSITION_M,ROTATION_DEG, e.g. 0.02,5: `train` reads a copy of the dataset whose
 # observation.state hand poses carry fixed per-frame Gaussian noise of those standard deviations, metres per axis and
 # degrees per rotation-vector component, heads, grippers and actions exact: $WORK/dataset_<CONDITION>_state_noise,
 # made once by `tavis noise-state` with seed SEED; needs STATE_INPUT=on; `overfit` ignores it), ACTIONS (absolute;
-# hand_relative: the `act_hand_relative` policy, ACT whose chunks hold the arm poses in the frame of the hand as
-# measured when the chunk is planned, observation.state read as that anchor alone; needs STATE_INPUT=off),
+# hand_relative: the `act_hand_relative_<CONDITION>_compact` preset, ACT whose chunks hold the arm poses in the frame
+# of the hand as measured when the chunk is planned, observation.state read as that anchor alone, with the time
+# since the episode began as an input; its own budget unless set: STEPS 3200, SAVE_FREQ 800, BATCH 128),
 # WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
 #   comparison); logs in $WORK/cell_<condition>.log.
-# - cell: the whole cell within one 30-minute GPU slot: data, then STEPS (4800) steps of BATCH 128 with SAVE_FREQ
-#   1600 unless set (loaders: WORKERS - 2; the preset anneals the lr to 0 at the last step; about 13 minutes with
+# - cell: the whole cell within one 30-minute GPU slot: data, then STEPS (4800; ACTIONS=hand_relative: 3200) steps of
+#   BATCH 128 with SAVE_FREQ 1600 (800) unless set (loaders: WORKERS - 2; the preset anneals the lr to 0 at the last step; about 13 minutes with
 #   16 cores and an evaluation beside; TRAIN_S, 960 s, only guards the slot), the checkpoints evaluated at low CPU
 #   priority as they appear, and those left after training ends side by side.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
@@ -58,9 +60,9 @@ FILM=${FILM:-2}
 EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
 SEED=${SEED:-1000}
 CHECKPOINTS=${CHECKPOINTS:-all}
-STATE_INPUT=${STATE_INPUT:-on}
-STATE_NOISE=${STATE_NOISE:-}
 ACTIONS=${ACTIONS:-absolute}
+if [ "$ACTIONS" = hand_relative ]; then STATE_INPUT=${STATE_INPUT:-off}; else STATE_INPUT=${STATE_INPUT:-on}; fi
+STATE_NOISE=${STATE_NOISE:-}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 read -ra train_options <<< "${TRAIN_OPTIONS:-}"
 WORK=${WORK:-/tmp/tavis_baseline}
@@ -81,8 +83,8 @@ esac
 case "$ACTIONS" in
   absolute) ;;
   hand_relative) if [ "$STATE_INPUT" = on ]; then
-      echo "ACTIONS=hand_relative needs STATE_INPUT=off: act_hand_relative reads observation.state only as the" \
-        "anchor of its chunks, never as a network input" >&2
+      echo "ACTIONS=hand_relative takes STATE_INPUT=off alone: act_hand_relative reads observation.state only as" \
+        "the anchor of its chunks, never as a network input" >&2
       exit 2
     fi ;;
   *) echo "ACTIONS must be absolute or hand_relative, got '$ACTIONS'" >&2; exit 2 ;;
@@ -125,19 +127,17 @@ while chunk := os.read(0, 1 << 16):
         sys.exit(3)
     seen = chunk'
 
-preset() {  # prints the path of the condition's compact preset; with STATE_INPUT=off, of a copy without the state
-  # input (and with ACTIONS=hand_relative, of the act_hand_relative policy)
+preset() {  # prints the path of the condition's compact preset (ACTIONS=hand_relative: the hand-frame one); with
+  # STATE_INPUT=off and absolute actions, of a copy without the state input
   local shipped copy="$WORK/preset_act_${CONDITION}_compact_no_state.json"
-  [ "$ACTIONS" = absolute ] || copy="$WORK/preset_act_${CONDITION}_compact_${ACTIONS}.json"
+  if [ "$ACTIONS" = hand_relative ]; then tavis presets "act_hand_relative_${CONDITION}_compact"; return; fi
   shipped=$(tavis presets "act_${CONDITION}_compact")
   if [ "$STATE_INPUT" = on ]; then echo "$shipped"; return; fi
   mkdir -p "$WORK"
-  python3 - "$shipped" "$copy" "$ACTIONS" <<'PY'
+  python3 - "$shipped" "$copy" <<'PY'
 import json, os, sys
 preset = json.load(open(sys.argv[1]))
 del preset["policy"]["input_features"]["observation.state"]
-if sys.argv[3] == "hand_relative":
-    preset["policy"]["type"] = "act_hand_relative"
 with open(sys.argv[2] + ".tmp", "w") as copy:
     json.dump(preset, copy, indent=2)
 os.replace(sys.argv[2] + ".tmp", sys.argv[2])
@@ -206,8 +206,10 @@ case "${1:-}" in
     "$0" data
     stopped="$WORK/train_$CONDITION.stopped"
     rm -f "$stopped"
-    ( BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1600} STEPS=${STEPS:-4800} \
-        WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-960}" "$0" train || true
+    if [ "$ACTIONS" = absolute ]; then  # the hand-frame preset holds its own budget
+      export BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1600} STEPS=${STEPS:-4800}
+    fi
+    ( WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-960}" "$0" train || true
       touch "$stopped" ) &
     ( while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
         nice -n 15 "$0" eval

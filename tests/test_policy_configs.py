@@ -43,7 +43,7 @@ def _parse(name, *overrides):
 
 
 def test_the_shipped_files_are_the_generated_presets():
-    assert len(preset_names()) == 10
+    assert len(preset_names()) == 12
     for name, (policy, mode, compact) in presets().items():
         assert json.loads(preset_path(name).read_text()) == build_preset(policy, mode, compact), name
     with pytest.raises(ValueError, match="unknown preset"):
@@ -62,7 +62,8 @@ def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_r
     cfg = _parse(name, "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}")
     policy, mode, compact = presets()[name]
     assert cfg.policy.type == policy and cfg.env.type == "tavis" and cfg.env.camera_mode == mode
-    assert (cfg.policy.n_action_steps, cfg.batch_size) == ((10, 64) if compact else (8, 16))
+    batch = {"act": 64, "act_hand_relative": 128}.get(policy, 16)
+    assert (cfg.policy.n_action_steps, cfg.batch_size) == ((10 if compact else 8), batch)
     dataset_features = dataset_to_policy_features(LeRobotDatasetMetadata("local/tiny", root=dataset_root).features)
     env_keys = set(cfg.env.features_map.values())
     for key, feature in cfg.policy.input_features.items():
@@ -76,16 +77,20 @@ def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_r
         assert tuple(cfg.policy.resize_shape) == (240, 320) == tuple(cfg.env.image_size)
         assert cfg.policy.pretrained_backbone_weights is None and cfg.policy.use_group_norm
         assert cfg.policy.noise_scheduler_type == "DDPM"
-    elif policy == "act":
+    elif policy.startswith("act"):
         assert (cfg.policy.chunk_size, cfg.policy.optimizer_lr, cfg.policy.optimizer_lr_backbone) == (20, 1e-4, 1e-4)
         assert cfg.policy.pretrained_backbone_weights is None and tuple(cfg.env.image_size) == (120, 160)
         assert all(f.shape[1:] == (120, 160) for k, f in cfg.policy.input_features.items() if "images" in k)
+        hand_relative = policy == "act_hand_relative"
+        assert ("observation.state" in cfg.policy.input_features) is not hand_relative
+        assert (cfg.steps, cfg.save_freq) == ((3200, 800) if hand_relative else (6000, 2000))
+        assert getattr(cfg.policy, "time_input", False) is hand_relative
     else:
         assert (cfg.policy.chunk_size, cfg.policy.optimizer_lr) == (16, 2.5e-5)
         assert str(cfg.policy.pretrained_path) == "lerobot/pi0_base"
 
 
-@pytest.mark.parametrize("name", ["act_head_wrist_compact", "act_fixed_wrist_compact"])
+@pytest.mark.parametrize("name", [name for name, (_, _, compact) in presets().items() if compact])
 def test_compact_presets_anneal_the_learning_rate_to_zero_at_the_last_step(name):
     import torch
     from lerobot.optim.factory import make_optimizer_and_scheduler
@@ -134,16 +139,19 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
     assert info["overall"]["n_episodes"] == 1
 
 
-@pytest.mark.parametrize(("policy_type", "extra"), [("act", {}), ("act_hand_relative", {}),
-                                                    ("act_hand_relative", {"time_input": True})])
-def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, policy_type,
-                                                                             extra):
-    """benchmarks/train_baseline.sh's STATE_INPUT=off: the preset's inputs less observation.state; with
-    ACTIONS=hand_relative the policy type this package registers, which lerobot-train finds through the plugin, and
-    with its time input (a feature no dataset holds)."""
-    preset = json.loads(preset_path("act_head_wrist_compact").read_text())
-    del preset["policy"]["input_features"]["observation.state"]
-    preset["policy"] |= {"type": policy_type, **extra}
+@pytest.mark.parametrize(("name", "policy_type", "extra"), [
+    ("act_head_wrist_compact", "act", {}),
+    ("act_hand_relative_head_wrist_compact", "act_hand_relative", {}),
+    ("act_hand_relative_head_wrist_compact", "act_hand_relative", {"time_input": False}),
+])
+def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, name,
+                                                                             policy_type, extra):
+    """benchmarks/train_baseline.sh's STATE_INPUT=off: the compact preset's inputs less observation.state; the
+    hand-frame preset, whose policy type this package registers and lerobot-train finds through the plugin, with its
+    time input (a feature no dataset holds) and without."""
+    preset = json.loads(preset_path(name).read_text())
+    preset["policy"]["input_features"].pop("observation.state", None)
+    preset["policy"] |= extra
     for feature in preset["policy"]["input_features"].values():
         feature["shape"] = [3, *TINY]
     (tmp_path / "preset.json").write_text(json.dumps(preset))
@@ -156,6 +164,7 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
     assert config["type"] == policy_type and "observation.state" not in config["input_features"]
+    assert config.get("time_input", False) is extra.get("time_input", policy_type == "act_hand_relative")
     evaluate = [sys.executable, "-m", "lerobot_tavis.cli", "eval", "--policy", str(checkpoint), "--device", "cpu",
                 "--tasks", "conditional_pick", "--splits", "id", "--episodes", "1", "--workers", "1",
                 "--batch-size", "1", "--episode-length-s", "1", "--film-episodes", "0", "--out", str(tmp_path / "eval")]

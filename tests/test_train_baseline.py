@@ -119,20 +119,23 @@ def test_state_input_off_trains_from_a_copy_of_the_preset_without_the_state(tmp_
     assert refused.returncode == 2 and "STATE_INPUT must be on or off, got 'no'" in refused.stderr
 
 
-def test_hand_relative_actions_train_the_act_hand_relative_policy_from_a_copy_without_the_state(tmp_path):
-    shipped = preset_path("act_head_wrist_compact")
-    (train,) = [call for call in _run(tmp_path, "train", STATE_INPUT="off", ACTIONS="hand_relative",
+def test_hand_relative_actions_train_the_hand_frame_preset_on_its_own_budget(tmp_path):
+    shipped = preset_path("act_hand_relative_head_wrist_compact")
+    calls = _run(tmp_path, "cell", ACTIONS="hand_relative", PRESET_FILE=str(shipped))
+    assert "tavis presets act_hand_relative_head_wrist_compact | gpu= egl=" in calls
+    (train,) = [call for call in calls if call.startswith("lerobot-train")]
+    assert f"--config_path={shipped} " in train  # the shipped preset itself, no copy
+    assert not re.search(r"--(steps|save_freq|batch_size)=", train)  # the preset's 3200 / 800 / 128
+    (train,) = [call for call in _run(tmp_path / "set", "train", ACTIONS="hand_relative", STEPS="1600",
                                       PRESET_FILE=str(shipped)) if call.startswith("lerobot-train")]
-    copy = Path(re.search(r"--config_path=(\S+)", train)[1])
-    assert copy.name == "preset_act_head_wrist_compact_hand_relative.json"
-    expected = json.loads(shipped.read_text())
-    del expected["policy"]["input_features"]["observation.state"]
-    expected["policy"]["type"] = "act_hand_relative"
-    assert json.loads(copy.read_text()) == expected
+    assert "--steps=1600" in train and not re.search(r"--(save_freq|batch_size)=", train)
+    (train,) = [call for call in _run(tmp_path / "absolute", "cell", PRESET_FILE=str(shipped))
+                if call.startswith("lerobot-train")]
+    assert re.search(r"--steps=4800 --save_freq=1600 --batch_size=128( |$)", train.split(" | ")[0])
 
 
 @pytest.mark.parametrize(("settings", "message"), [
-    (dict(ACTIONS="hand_relative"), "ACTIONS=hand_relative needs STATE_INPUT=off"),
+    (dict(ACTIONS="hand_relative", STATE_INPUT="on"), "ACTIONS=hand_relative takes STATE_INPUT=off alone"),
     (dict(ACTIONS="relative", STATE_INPUT="off"), "ACTIONS must be absolute or hand_relative, got 'relative'"),
 ])
 def test_hand_relative_actions_with_the_state_input_or_unknown_actions_are_refused(tmp_path, settings, message):

@@ -20,6 +20,11 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
   cosine to 0 at the last of `--steps`, so a run's last checkpoint is its settled one: set `--steps` to the budget,
   not past it; `--optimizer.lr` changes the peak). A compact Diffusion Policy of the same budget did not reproduce
   even its own training episodes (docs/results/README.md), ACT does.
+- Hand-frame compact presets (`act_hand_relative_head_wrist_compact`, `act_hand_relative_fixed_wrist_compact`): the
+  same ACT as `act_hand_relative` (lerobot_tavis.policies), its arm actions in the frame of the hand measured when a
+  chunk is planned, the cameras its only network input, and the seconds since the episode began as one more
+  (`time_input`: without it a fixed + wrists policy never starts its reach); batch 128, 3200 steps, a checkpoint
+  every 800: the recipe of the best conditional_pick results (docs/results/README.md).
 
 The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
 keeps the two in step.
@@ -37,6 +42,7 @@ from lerobot_tavis.errors import InputError
 
 PRESET_DIR = Path(__file__).parent
 POLICIES = ("diffusion", "pi0")
+COMPACT_POLICIES = ("act", "act_hand_relative")
 PI0_BASE = "lerobot/pi0_base"
 PI0_TOKENIZER = "google/paligemma-3b-pt-224"
 DIFFUSION_IMAGE_SIZE = (240, 320)
@@ -46,13 +52,15 @@ PI0_IMAGE_SIZE = (480, 640)  # pi0 resizes and pads every camera to 224x224 itse
 CHUNK, EXECUTED = 16, 8
 COMPACT_CHUNK, COMPACT_EXECUTED = 20, 10
 COMPACT_LR = 1e-4  # ACT's default peak, for the backbone as for the transformer
+HAND_RELATIVE_BUDGET = {"batch_size": 128, "steps": 3200, "save_freq": 800}
 
 
 def presets() -> dict[str, tuple[str, str, bool]]:
     """Every shipped preset's name -> (policy, camera mode, compact); registered camera modes have none (their
     presets come from `build_preset`)."""
     table = {f"{policy}_{mode}": (policy, mode, False) for policy in POLICIES for mode in BUILTIN_CAMERA_MODES}
-    return table | {f"act_{mode}_compact": ("act", mode, True) for mode in COMPACT_MODES}
+    return table | {f"{policy}_{mode}_compact": (policy, mode, True)
+                    for policy in COMPACT_POLICIES for mode in COMPACT_MODES}
 
 
 def preset_names() -> list[str]:
@@ -72,9 +80,9 @@ def preset_path(name: str) -> Path:
 def build_preset(policy: str, camera_mode: str, compact: bool = False) -> dict:
     """The partial TrainPipelineConfig of one preset (`compact`: the fast ACT baseline, not the reference's)."""
     if compact:
-        if policy != "act":
-            raise ValueError(f"compact presets are ACT presets, got policy {policy!r}")
-        return _compact_act(camera_mode)
+        if policy not in COMPACT_POLICIES:
+            raise ValueError(f"compact presets are ACT presets ({', '.join(COMPACT_POLICIES)}), got policy {policy!r}")
+        return _compact_act(camera_mode) if policy == "act" else _compact_act_hand_relative(camera_mode)
     image_size = DIFFUSION_IMAGE_SIZE if policy == "diffusion" else PI0_IMAGE_SIZE
     inputs = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, *image_size]}
               for camera in mode_cameras(camera_mode)}
@@ -125,6 +133,15 @@ def _compact_act(camera_mode: str) -> dict:
                 "optimizer": {"type": "adamw", "lr": COMPACT_LR, "weight_decay": 1e-4, "grad_clip_norm": 10.0},
                 "scheduler": {"type": "cosine_annealing_with_warmup", "num_warmup_steps": 0}}
     return preset | schedule | {"batch_size": 64, "steps": 6000, "save_freq": 2000, "env_eval_freq": 0}
+
+
+def _compact_act_hand_relative(camera_mode: str) -> dict:
+    """The compact ACT preset as `act_hand_relative` with its time input and without the state input (which that
+    policy reads only as its chunks' anchor), on the budget of docs/results/README.md's hand-frame runs."""
+    preset = _compact_act(camera_mode)
+    del preset["policy"]["input_features"]["observation.state"]
+    preset["policy"] |= {"type": "act_hand_relative", "time_input": True}
+    return preset | HAND_RELATIVE_BUDGET
 
 
 def write_presets() -> list[Path]:
