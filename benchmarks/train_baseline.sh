@@ -30,9 +30,10 @@
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
 #   comparison); logs in $WORK/cell_<condition>.log.
 # - cell: the whole cell within one 30-minute GPU slot: data, then STEPS (4800; ACTIONS=hand_relative: 3200) steps of
-#   BATCH 128 with SAVE_FREQ 1600 (800) unless set (loaders: WORKERS - 2; the preset anneals the lr to 0 at the last step; about 13 minutes with
-#   16 cores and an evaluation beside; TRAIN_S, 960 s, only guards the slot), the checkpoints evaluated at low CPU
-#   priority as they appear, and those left after training ends side by side.
+#   BATCH 128 with SAVE_FREQ 1600 (800) unless set (loaders: WORKERS - 2; the preset anneals the lr to 0 at the last
+#   step; about 13 minutes with 16 cores and an evaluation beside, 10 for hand_relative; TRAIN_S, 960 s, only guards
+#   the slot), the checkpoints evaluated at low CPU priority as they appear, and those left after training ends side
+#   by side.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset; decodes with torchcodec when FFmpeg's

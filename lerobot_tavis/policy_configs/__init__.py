@@ -24,7 +24,8 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
   same ACT as `act_hand_relative` (lerobot_tavis.policies), its arm actions in the frame of the hand measured when a
   chunk is planned, the cameras its only network input, and the seconds since the episode began as one more
   (`time_input`: without it a fixed + wrists policy never starts its reach); batch 128, 3200 steps, a checkpoint
-  every 800: the recipe of the best conditional_pick results (docs/results/README.md).
+  every 800: the recipe of docs/results/README.md's hand-frame runs (its best conditional_pick result, 54.2%, was
+  trained with `--policy.time_input=false`).
 
 The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
 keeps the two in step.
