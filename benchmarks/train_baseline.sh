@@ -42,9 +42,9 @@
 #   (exit 3) instead of spending the slot on NaN checkpoints.
 # - eval: `tavis eval --policy` (LeRobot's evaluation loop, EVAL_JOBS runs of it sharing the GPU: one loop over
 #   48 envs stepped about 200 envs/s on 16 cores) on every complete checkpoint not yet evaluated (or the last
-#   alone: CHECKPOINTS=last; one step's: CHECKPOINTS=1600), seeds from 1000, side by side; it can run beside `train`, which marks a checkpoint
-#   complete by pointing `checkpoints/last` at it, and beside another `eval` call, which skips the checkpoints that
-#   one is evaluating.
+#   alone: CHECKPOINTS=last; one step's: CHECKPOINTS=1600), seeds from 1000, side by side; it can run beside
+#   `train`, which marks a checkpoint complete by pointing `checkpoints/last` at it, and beside another `eval` call,
+#   which skips the checkpoints that one is evaluating.
 # - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (3000) and
 #   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
 #   on points at a data or alignment bug, not at too little training.
