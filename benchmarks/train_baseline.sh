@@ -44,7 +44,8 @@
 #   48 envs stepped about 200 envs/s on 16 cores) on every complete checkpoint not yet evaluated (or the last
 #   alone: CHECKPOINTS=last; one step's: CHECKPOINTS=1600), seeds from 1000, side by side; it can run beside
 #   `train`, which marks a checkpoint complete by pointing `checkpoints/last` at it, and beside another `eval` call,
-#   which skips the checkpoints that one is evaluating.
+#   which skips the checkpoints that one is evaluating. Then `tavis curve` puts every finished checkpoint's success
+#   and GALT in one table and plot by training step: $WORK/$EVAL_NAME/checkpoints.md and checkpoints.png.
 # - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (3000) and
 #   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
 #   on points at a data or alignment bug, not at too little training.
@@ -248,6 +249,9 @@ case "${1:-}" in
       ( trap 'rmdir "$out.running"' EXIT; time evaluate "$checkpoint" "$out" 1000 "$EVAL_EPISODES" ) &
     done
     wait
+    if compgen -G "$WORK/$EVAL_NAME/step_*/results.json" > /dev/null; then
+      tavis curve "$WORK/$EVAL_NAME"  # success by training step over every checkpoint evaluated so far
+    fi
     ;;
   overfit)
     choose_video_backend

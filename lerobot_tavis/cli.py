@@ -67,6 +67,12 @@ class ReportOptions:
     workers: int | None = option(None, "processes annotating the videos (default: every core this process may use)")
 
 
+@dataclass(frozen=True)
+class CurveOptions:
+    eval_root: Path = option(help="directory holding one `tavis eval` output per checkpoint, named step_<N>",
+                             positional=True)
+
+
 def _printing(target: str):
     """A subcommand's run: call `target` ("module:function", imported only when the subcommand runs) with the
     options and print each line it returns (written files, messages)."""
@@ -83,6 +89,13 @@ def _report(options: ReportOptions) -> None:
     from lerobot_tavis.eval.report import write_report
 
     for path in write_report(options.eval_dir, options.workers):
+        print(path)
+
+
+def _curve(options: CurveOptions) -> None:
+    from lerobot_tavis.eval.checkpoint_curve import write_curve
+
+    for path in write_curve(options.eval_root):
         print(path)
 
 
@@ -196,6 +209,8 @@ def build_parser() -> argparse.ArgumentParser:
          "lerobot-train with a preset (checks pi0 downloads first); extra arguments go to lerobot-train"),
         ("report", ReportOptions, _report,
          "success rates with Wilson CIs, GALT, failure stages, plots from eval outputs"),
+        ("curve", CurveOptions, _curve,
+         "success by training step from one eval output per checkpoint (step_<N>/): checkpoints.md and .png"),
     ):
         commands.add_parser(name, help=help, options=options).set_defaults(run=run)
     return parser

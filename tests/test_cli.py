@@ -64,6 +64,7 @@ COMMAND_LINES = {
     "train": (["diffusion_head_wrist", "--steps=10", "--dataset.root=data"],
               dict(preset="diffusion_head_wrist", lerobot_args=("--steps=10", "--dataset.root=data"))),
     "report": (["evals"], dict(eval_dir=Path("evals"))),
+    "curve": (["evals"], dict(eval_root=Path("evals"))),
 }
 # The least each subcommand needs, and what the dataclass is then built with directly: the rest are its defaults.
 MINIMAL = {
@@ -83,6 +84,7 @@ MINIMAL = {
     "presets": ([], {}),
     "train": (["diffusion_head_wrist"], dict(preset="diffusion_head_wrist", lerobot_args=())),
     "report": (["evals"], dict(eval_dir=Path("evals"))),
+    "curve": (["evals"], dict(eval_root=Path("evals"))),
 }
 OFF_THE_COMMAND_LINE = {"record": {"max_attempts_factor"}, "view": {"max_frames"}}
 

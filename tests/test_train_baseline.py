@@ -56,6 +56,8 @@ def test_pair_trains_each_condition_on_its_own_visible_gpu_and_evaluates_every_c
     assert evals == [f"{work}/eval_{condition}/step_{step} | gpu={gpu} egl={gpu}"
                      for condition, gpu in (("fixed_wrist", 3), ("head_wrist", 2)) for step in (1500, 3000)]
     assert all("--tasks conditional_pick --splits id --episodes 96" in call for call in calls if "tavis eval" in call)
+    curves = {call.split(" | ")[0] for call in calls if call.startswith("tavis curve")}
+    assert curves == {f"tavis curve {work}/eval_{condition}" for condition in ("fixed_wrist", "head_wrist")}
 
 
 def test_eval_options_reach_tavis_eval_and_its_folder_is_eval_name(tmp_path):
@@ -72,7 +74,8 @@ def test_checkpoints_picks_the_last_or_one_steps_checkpoint(tmp_path, checkpoint
     _run(tmp_path, "train")
     calls = _run(tmp_path / "again", "eval", WORK=str(tmp_path / "work"), CHECKPOINTS=checkpoints,
                  EVAL_NAME="eval_te")
-    assert [call.split(" | ")[0].split(" --out ")[1] for call in calls] == [f"{tmp_path}/work/eval_te/step_{step}"]
+    evals = [call.split(" | ")[0].split(" --out ")[1] for call in calls if call.startswith("tavis eval")]
+    assert evals == [f"{tmp_path}/work/eval_te/step_{step}"]
 
 
 @pytest.mark.parametrize("checkpoints", ["first", "16o0", "-1600"])

@@ -217,8 +217,11 @@ def build_report(root: Path) -> dict:
             "average": average, **deltas, "sources": sources}
 
 
-def _pct(rate: float, low: float, high: float) -> str:
-    return f"{100 * rate:5.1f}% [{100 * low:4.1f}, {100 * high:5.1f}]"
+def rate_text(summary: dict) -> str:
+    """A cell's (or pooled average's) success rate, Wilson interval and episode count as the tables print them:
+    ` 50.0% [40.2,  59.8] (96)`."""
+    rate, low, high = summary["success_rate"], summary["ci_low"], summary["ci_high"]
+    return f"{100 * rate:5.1f}% [{100 * low:4.1f}, {100 * high:5.1f}] ({summary['n']})"
 
 
 def markdown(report: dict) -> str:
@@ -232,14 +235,12 @@ def markdown(report: dict) -> str:
              "| task | " + " | ".join([*splits, *(f"id - {split}" for split in deltas)]) + " |",
              "|---|" + "---|" * (len(splits) + len(deltas))]
     for task in tasks:
-        row = [_pct(c["success_rate"], c["ci_low"], c["ci_high"]) + f" ({c['n']})" if (c := cells.get((task, s)))
-               else "" for s in splits]
+        row = [rate_text(c) if (c := cells.get((task, s))) else "" for s in splits]
         for split in deltas:
             delta = report[f"id_minus_{split}"].get(task)
             row.append(f"{100 * delta:+.1f} pp" if delta is not None else "")
         lines.append(f"| {task} | " + " | ".join(row) + " |")
-    avg = [_pct(a["success_rate"], a["ci_low"], a["ci_high"]) + f" ({a['n']})" for a in
-           (report["average"][s] for s in splits)]
+    avg = [rate_text(report["average"][s]) for s in splits]
     lines += ["| **AVERAGE** (pooled) | " + " | ".join(avg + [""] * len(deltas)) + " |"]
     for metric in episode_metrics():
         lines += _lead_table(cells, tasks, splits, metric.name, metric.caption)
@@ -329,7 +330,7 @@ def plot(report: dict, out_dir: Path) -> list[Path]:
     ax.set_ylim(0, 105)
     ax.legend()
     fig.tight_layout()
-    written.append(_save(fig, out_dir / "success_rates.png"))
+    written.append(save_figure(fig, out_dir / "success_rates.png"))
     for metric in (m for m in episode_metrics() if m.histogram is not None):
         for task in tasks:
             values = {s: c[f"{metric.name}_values_s"] for s in splits if (c := cells.get((task, s))) is not None}
@@ -342,12 +343,13 @@ def plot(report: dict, out_dir: Path) -> list[Path]:
             ax.set_title(task)
             ax.legend()
             fig.tight_layout()
-            written.append(_save(fig, out_dir / f"{metric.name}_{task}.png"))
+            written.append(save_figure(fig, out_dir / f"{metric.name}_{task}.png"))
             plt.close("all")
     return written
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path: Path) -> Path:
+    """Write `fig` to `path` as a 120-dpi PNG, complete or not at all."""
     with atomic_path(path, suffix=".png") as partial:  # matplotlib picks the format from the extension
         fig.savefig(partial, dpi=120)
     return path
