@@ -208,10 +208,10 @@ case "${1:-}" in
     "$0" data
     stopped="$WORK/train_$CONDITION.stopped"
     rm -f "$stopped"
-    if [ "$ACTIONS" = absolute ]; then  # the hand-frame preset holds its own budget
-      export BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1600} STEPS=${STEPS:-4800}
-    fi
-    ( WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-960}" "$0" train || true
+    ( if [ "$ACTIONS" = absolute ]; then  # the hand-frame preset holds its own budget
+        export BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1600} STEPS=${STEPS:-4800}
+      fi
+      WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-960}" "$0" train || true
       touch "$stopped" ) &
     ( while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
         nice -n 15 "$0" eval
