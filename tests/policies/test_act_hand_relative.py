@@ -116,6 +116,30 @@ def test_training_sees_the_chunk_in_the_hand_frame_normalised_by_its_statistics(
     assert seen[IMAGE] is batch[IMAGE]
 
 
+@pytest.mark.parametrize(("amp_dtype", "autocast", "runs_in"), [
+    ("bfloat16", torch.float16, torch.bfloat16), ("float16", torch.float16, torch.float16),
+    ("bfloat16", None, torch.float32)])
+def test_under_amp_the_network_runs_in_its_amp_dtype_whatever_autocast_asked(dataset_root, amp_dtype, autocast,
+                                                                             runs_in):
+    root, episodes = dataset_root
+    policy = ACTHandRelativePolicy(_config(amp_dtype=amp_dtype), dataset_stats=_action_stats(episodes),
+                                   dataset_meta=SimpleNamespace(root=root, fps=20))
+    seen = []
+    policy.model.action_head.register_forward_hook(lambda module, inputs, output: seen.append(output.dtype))
+    batch, _ = _batch(np.random.default_rng(1), policy, 2)
+    with torch.autocast("cpu", dtype=autocast, enabled=autocast is not None):  # as lerobot-train / lerobot-eval
+        loss, _ = policy.forward(batch)
+        policy.reset()
+        action = policy.select_action(batch)
+    assert seen == [runs_in, runs_in]
+    assert torch.isfinite(loss) and action.dtype == torch.float32
+
+
+def test_an_amp_dtype_other_than_bfloat16_or_float16_is_refused():
+    with pytest.raises(ValueError, match="amp_dtype must be one of bfloat16, float16; got 'float32'"):
+        _config(amp_dtype="float32")
+
+
 def test_a_predicted_chunk_comes_back_absolute_anchored_on_the_state_it_was_planned_from(policy, monkeypatch):
     batch, absolute = _batch(np.random.default_rng(2), policy, 2)
     planned_from = batch[OBS_STATE]

@@ -11,6 +11,8 @@ from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_STATE
 
 from lerobot_tavis import canonical
 
+AMP_DTYPES = ("bfloat16", "float16")
+
 
 @PreTrainedConfig.register_subclass("act_hand_relative")
 @dataclass
@@ -26,11 +28,24 @@ class ACTHandRelativeConfig(ACTConfig):
     (added to `input_features`; the dataset's `timestamp` in training, `fps` steps per second counted since `reset()`
     when acting). It tells apart moments whose images are the same, such as the start of an episode while the
     demonstrator looks at what the policy's cameras do not show.
+
+    `amp_dtype`: the precision the network runs in under AMP (`use_amp`, lerobot-train's and lerobot-eval's autocast,
+    which is float16 on CUDA): bfloat16 by default, float32's range, because the ResNet starts from random weights
+    (no pretrained weights are reachable) under frozen batch norm and nothing bounds its activations: in float16 they
+    overflowed, and the loss became NaN for good, in three ACT trainings of docs/results/README.md. "float16" is
+    LeRobot's ACT's precision.
     """
 
     time_input: bool = False
     fps: float = 20.0  # policy steps per second when acting (TAVIS's rate, envs.physics.POLICY_HZ); training sets
     # the dataset's
+    amp_dtype: str = "bfloat16"
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.amp_dtype not in AMP_DTYPES:
+            raise ValueError(f"act_hand_relative's amp_dtype must be one of {', '.join(AMP_DTYPES)}; got "
+                             f"{self.amp_dtype!r}")
 
     def validate_features(self) -> None:
         if self.time_input:

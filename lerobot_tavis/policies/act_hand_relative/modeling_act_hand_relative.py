@@ -9,6 +9,8 @@ has moved meanwhile. The four statistics vectors are buffers, saved with the wei
 
 from __future__ import annotations
 
+from contextlib import nullcontext
+
 import numpy as np
 import torch
 from torch import Tensor
@@ -62,7 +64,8 @@ class ACTHandRelativePolicy(ACTPolicy):
         batch = {**batch, ACTION: (relative - self.relative_mean) / (self.relative_std + EPS)}
         if self.config.time_input:
             batch[OBS_ENV_STATE] = self._time_token(batch["timestamp"], batch[ACTION])
-        return super().forward(batch)
+        with self._amp_precision(relative.device):
+            return super().forward(batch)
 
     @torch.no_grad()
     def select_action(self, batch: dict[str, Tensor]) -> Tensor:
@@ -80,9 +83,17 @@ class ACTHandRelativePolicy(ACTPolicy):
             state = batch[OBS_STATE]
             elapsed_s = torch.full(state.shape[:1], self._elapsed_steps / self.config.fps)
             batch = {**batch, OBS_ENV_STATE: self._time_token(elapsed_s, state)}
-        relative = super().predict_action_chunk(batch).float() * (self.relative_std + EPS) + self.relative_mean
+        with self._amp_precision(batch[OBS_STATE].device):
+            relative = super().predict_action_chunk(batch).float()
+        relative = relative * (self.relative_std + EPS) + self.relative_mean
         absolute = from_hand_frame(relative, batch[OBS_STATE].float())
         return (absolute - self.absolute_mean) / (self.absolute_std + EPS)
+
+    def _amp_precision(self, device: torch.device):
+        """Under AMP (autocast on `device`), autocast in `config.amp_dtype` instead; otherwise nothing changes."""
+        if not torch.is_autocast_enabled(device.type):
+            return nullcontext()
+        return torch.autocast(device.type, dtype=getattr(torch, self.config.amp_dtype))
 
     @staticmethod
     def _time_token(elapsed_s: Tensor, like: Tensor) -> Tensor:
