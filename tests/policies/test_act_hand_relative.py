@@ -138,6 +138,10 @@ def test_under_amp_the_network_runs_in_its_amp_dtype_whatever_autocast_asked(dat
 def test_an_amp_dtype_other_than_bfloat16_or_float16_is_refused():
     with pytest.raises(ValueError, match="amp_dtype must be one of bfloat16, float16; got 'float32'"):
         _config(amp_dtype="float32")
+    config = _config()
+    config.amp_dtype = "half"  # as `tavis eval --policy-option amp_dtype=half` sets it on a loaded config
+    with pytest.raises(ValueError, match="got 'half'"):
+        config.validate_features()
 
 
 def test_a_predicted_chunk_comes_back_absolute_anchored_on_the_state_it_was_planned_from(policy, monkeypatch):

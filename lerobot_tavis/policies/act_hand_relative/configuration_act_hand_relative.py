@@ -43,11 +43,10 @@ class ACTHandRelativeConfig(ACTConfig):
 
     def __post_init__(self):
         super().__post_init__()
-        if self.amp_dtype not in AMP_DTYPES:
-            raise ValueError(f"act_hand_relative's amp_dtype must be one of {', '.join(AMP_DTYPES)}; got "
-                             f"{self.amp_dtype!r}")
+        self._check_amp_dtype()
 
     def validate_features(self) -> None:
+        self._check_amp_dtype()  # again: `tavis eval --policy-option` sets fields after construction
         if self.time_input:
             self.input_features.setdefault(OBS_ENV_STATE, PolicyFeature(FeatureType.ENV, (1,)))
         super().validate_features()
@@ -62,3 +61,8 @@ class ACTHandRelativeConfig(ACTConfig):
         if action is None or tuple(action.shape) != (canonical.ACTION_DIM,):
             raise ValueError(f"act_hand_relative needs TAVIS's {canonical.ACTION_DIM}-D canonical {ACTION}, got "
                              f"{None if action is None else tuple(action.shape)}")
+
+    def _check_amp_dtype(self) -> None:
+        if self.amp_dtype not in AMP_DTYPES:
+            raise ValueError(f"act_hand_relative's amp_dtype must be one of {', '.join(AMP_DTYPES)}; got "
+                             f"{self.amp_dtype!r}")
