@@ -38,9 +38,9 @@
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset (ACTIONS=hand_relative:
 #   `act_hand_relative_<CONDITION>_compact`); decodes with torchcodec when FFmpeg's libraries can be found (PyAV's
-#   bundled copy, tools/pyav_ffmpeg.sh), else with PyAV. A run whose logged loss becomes NaN (float16 AMP overflowing: three ACT trainings in docs/results; the hand-frame preset runs its network
-#   in bfloat16 under AMP for that reason) is stopped there and fails (exit 3) instead of spending the slot on NaN
-#   checkpoints.
+#   bundled copy, tools/pyav_ffmpeg.sh), else with PyAV. A run whose logged loss becomes NaN (float16 AMP
+#   overflowing: three ACT trainings in docs/results; the hand-frame preset runs its network in bfloat16 under AMP
+#   for that reason) is stopped there and fails (exit 3) instead of spending the slot on NaN checkpoints.
 # - eval: `tavis eval --policy` (LeRobot's evaluation loop, EVAL_JOBS runs of it sharing the GPU: one loop over
 #   48 envs stepped about 200 envs/s on 16 cores) on every complete checkpoint not yet evaluated (or the last
 #   alone: CHECKPOINTS=last; one step's: CHECKPOINTS=1600), seeds from 1000, side by side; it can run beside
