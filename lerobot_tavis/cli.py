@@ -73,6 +73,13 @@ class CurveOptions:
                              positional=True)
 
 
+@dataclass(frozen=True)
+class CompareOptions:
+    eval_a: Path = option(help="a `tavis eval` output (or any folder of lerobot-eval outputs with episode logs)",
+                          positional=True)
+    eval_b: Path = option(help="another one, evaluated on the same seeds", positional=True)
+
+
 def _printing(target: str):
     """A subcommand's run: call `target` ("module:function", imported only when the subcommand runs) with the
     options and print each line it returns (written files, messages)."""
@@ -211,6 +218,8 @@ def build_parser() -> argparse.ArgumentParser:
          "success rates with Wilson CIs, GALT, failure stages, plots from eval outputs"),
         ("curve", CurveOptions, _curve,
          "success by training step from one eval output per checkpoint (step_<N>/): checkpoints.md and .png"),
+        ("compare", CompareOptions, _printing("lerobot_tavis.eval.compare:run_compare"),
+         "two evaluations of the same seeds, episode by episode: successes of each and the exact McNemar test"),
     ):
         commands.add_parser(name, help=help, options=options).set_defaults(run=run)
     return parser

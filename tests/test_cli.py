@@ -65,6 +65,7 @@ COMMAND_LINES = {
               dict(preset="diffusion_head_wrist", lerobot_args=("--steps=10", "--dataset.root=data"))),
     "report": (["evals"], dict(eval_dir=Path("evals"))),
     "curve": (["evals"], dict(eval_root=Path("evals"))),
+    "compare": (["a", "b"], dict(eval_a=Path("a"), eval_b=Path("b"))),
 }
 # The least each subcommand needs, and what the dataclass is then built with directly: the rest are its defaults.
 MINIMAL = {
@@ -85,6 +86,7 @@ MINIMAL = {
     "train": (["diffusion_head_wrist"], dict(preset="diffusion_head_wrist", lerobot_args=())),
     "report": (["evals"], dict(eval_dir=Path("evals"))),
     "curve": (["evals"], dict(eval_root=Path("evals"))),
+    "compare": (["a", "b"], dict(eval_a=Path("a"), eval_b=Path("b"))),
 }
 OFF_THE_COMMAND_LINE = {"record": {"max_attempts_factor"}, "view": {"max_frames"}}
 

@@ -15,17 +15,17 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
 - pi0 presets need `lerobot/pi0_base` and its tokenizer from the Hub or the local cache; `tavis train` checks that
   first and says what is missing.
 - Compact presets (`act_head_wrist_compact`, `act_fixed_wrist_compact`: the paper's two camera conditions) are not
-  the reference's: ACT sized to train a baseline within one 30-minute GPU slot (120x160 frames, a ResNet-18 from
+  the reference's: ACT sized to train a baseline in minutes on one GPU (120x160 frames, a ResNet-18 from
   random weights, a chunk of 20 of which 10 are executed, batch 64, 6000 steps, AdamW at lr 1e-4 annealed along a
   cosine to 0 at the last of `--steps`, so a run's last checkpoint is its settled one: set `--steps` to the budget,
   not past it; `--optimizer.lr` changes the peak). A compact Diffusion Policy of the same budget did not reproduce
-  even its own training episodes (docs/results/README.md), ACT does.
+  even its own training episodes (docs/results/history.md), ACT does.
 - Hand-frame compact presets (`act_hand_relative_head_wrist_compact`, `act_hand_relative_fixed_wrist_compact`): the
   same ACT as `act_hand_relative` (lerobot_tavis.policies), its arm actions in the frame of the hand measured when a
   chunk is planned, the cameras its only network input, and the seconds since the episode began as one more
   (`time_input`: without it a fixed + wrists policy never starts its reach); batch 128, 3200 steps, a checkpoint
-  every 800: the recipe of docs/results/README.md's hand-frame runs (its best conditional_pick result, 54.2%, was
-  trained with `--policy.time_input=false`).
+  every 800: the recipe of the trained baselines (docs/results/README.md); `--policy.time_input=false` suits a head +
+  wrists policy alone better.
 
 The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
 keeps the two in step.
@@ -114,8 +114,8 @@ def build_preset(policy: str, camera_mode: str, compact: bool = False) -> dict:
 
 
 def _compact_act(camera_mode: str) -> dict:
-    """ACT on the reference-faithful preset's cameras and state at 120x160, sized for one GPU slot; measured in
-    docs/training.md and docs/results/README.md."""
+    """ACT on the reference-faithful preset's cameras and state at 120x160, sized to train in minutes on one GPU
+    (docs/training.md)."""
     if camera_mode not in COMPACT_MODES:
         raise ValueError(f"compact presets exist for {COMPACT_MODES}, got {camera_mode!r}")
     preset = build_preset("diffusion", camera_mode)
@@ -138,7 +138,7 @@ def _compact_act(camera_mode: str) -> dict:
 
 def _compact_act_hand_relative(camera_mode: str) -> dict:
     """The compact ACT preset as `act_hand_relative` with its time input and without the state input (which that
-    policy reads only as its chunks' anchor), on the budget of docs/results/README.md's hand-frame runs."""
+    policy reads only as its chunks' anchor), on the hand-frame budget (`HAND_RELATIVE_BUDGET`)."""
     preset = _compact_act(camera_mode)
     del preset["policy"]["input_features"]["observation.state"]
     preset["policy"] |= {"type": "act_hand_relative", "time_input": True}

@@ -32,8 +32,7 @@ class ACTHandRelativeConfig(ACTConfig):
     `amp_dtype`: the precision the network runs in under AMP (`use_amp`, lerobot-train's and lerobot-eval's autocast,
     which is float16 on CUDA): bfloat16 by default, float32's range, because the ResNet starts from random weights
     (no pretrained weights are reachable) under frozen batch norm and nothing bounds its activations: in float16 they
-    overflowed, and the loss became NaN, in three ACT trainings of docs/results/README.md. "float16" is
-    LeRobot's ACT's precision.
+    can overflow and turn the loss NaN for good. "float16" is LeRobot's ACT's precision.
     """
 
     time_input: bool = False
