@@ -188,7 +188,8 @@ class Manifest:
         if not path.is_file():
             raise PathNotFoundError(f"{path} not found: is {raw_dir} a directory written by `tavis record`?")
         document = read_json(path)
-        if not isinstance(document, dict) or [document.get("format"), document.get("version")] != [FORMAT, FORMAT_VERSION]:
+        if not (isinstance(document, dict) and document.get("format") == FORMAT
+                and document.get("version") == FORMAT_VERSION):
             raise RawEpisodeError(f"{path}: not a {FORMAT} v{FORMAT_VERSION} manifest")
         recorded = document.pop("sha256", None)
         if recorded is not None and recorded != _content_sha256(document):
