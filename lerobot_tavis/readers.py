@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -37,7 +38,7 @@ def read_json(path: str | Path) -> object:
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a JSON file (not UTF-8 text)") from None
     except json.JSONDecodeError as error:
-        raise InputError(f"{path}: not a JSON file ({error.msg} at line {error.lineno})") from None
+        raise InputError(f"{path}: not a JSON file ({error.msg}: line {error.lineno}, column {error.colno})") from None
     except OSError as error:
         raise InputError(f"{path}: unreadable ({error.strerror or error})") from None
 
@@ -73,7 +74,8 @@ def read_parquet(path: str | Path, columns: list[str] | None = None):
     try:
         return pq.read_table(path, columns=columns)
     except (pa.ArrowException, OSError) as error:
-        raise InputError(f"{path}: not a readable Parquet file ({str(error).splitlines()[0]})") from None
+        reason = re.sub(r"^Could not open Parquet input source '.*?': ", "", str(error).splitlines()[0]).split(". ")[0]
+        raise InputError(f"{path}: not a readable Parquet file ({reason})") from None
 
 
 def expect(value, kind: str, path: str | Path, field: str, optional: bool = False):
