@@ -105,9 +105,12 @@ class Cell:
 # What the report reads from every episode record and what each must be (`readers.KINDS`); the log writes more.
 RECORD_FIELDS = {"robot": "str", "suite": "str", "task": "str", "task_id": "int", "split": "str",
                  "camera_mode": "str", "seed": "int", "success": "bool"}
-# Fields the report and the video annotation read where present (null allowed): metric times in seconds, reasons.
+# Fields the report and the video annotation read where present, null allowed; besides them, every `<name>_s` field
+# (metric times, seconds) must be a number and every `<name>_reason` a text.
 OPTIONAL_RECORD_FIELDS = {"length_steps": "int", "prompt": "str", "instability": "str", "reach": "object"}
-REACH_FIELDS = ("closest_hand_m", "target_moved_m")  # what every `reach` holds (numbers); its others may be null
+# The `reach` fields the report reads (metres): always there, and there or null in older logs.
+REACH_FIELDS, OPTIONAL_REACH_FIELDS = ("closest_hand_m", "target_moved_m"), ("closest_hand_other_m",
+                                                                             "first_grasp_xy_m", "command_gap_m")
 
 
 def read_episode_log(path: Path) -> list[dict]:
@@ -128,12 +131,9 @@ def read_episode_log(path: Path) -> list[dict]:
                                                         "str" if name.endswith("_reason") else None)
             if kind:
                 expect(value, kind, where, name, optional=True)
-        reach = record.get("reach") or {}
-        for name, value in reach.items():
-            expect(value, "number", where, f"reach.{name}", optional=name not in REACH_FIELDS)
-        if reach:
-            for name in REACH_FIELDS:
-                get(reach, name, "number", where, "reach.")
+        if record.get("reach"):
+            for name in (*REACH_FIELDS, *OPTIONAL_REACH_FIELDS):
+                get(record["reach"], name, "number", where, "reach.", optional=name in OPTIONAL_REACH_FIELDS)
         records.append(record)
     return records
 
