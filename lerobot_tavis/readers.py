@@ -14,6 +14,7 @@ import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+from lerobot_tavis import checks
 from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError
 
 # What a field must be, as `expect` checks it: a name for the message and a test. bool is no integer here.
@@ -91,6 +92,11 @@ def get(document: dict, key: str, kind: str, path: str | Path, where: str = "", 
     if key not in document and not optional:
         raise InputError(f"{path}: {where}{key} is missing")
     return expect(document.get(key), kind, path, where + key, optional)
+
+
+def get_integer(document: dict, key: str, path: str | Path, where: str = "", minimum: int = 0) -> int:
+    """`document[key]` as an int, refused unless it is a whole number >= `minimum` (`checks.integer`)."""
+    return checked(lambda value: checks.integer(key, value, minimum), document.get(key), path, where + key)
 
 
 def checked(check: Callable, value, path: str | Path, field: str):

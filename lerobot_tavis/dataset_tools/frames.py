@@ -10,9 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_tavis import checks
 from lerobot_tavis.errors import InputError, PathNotFoundError
-from lerobot_tavis.readers import checked, expect, get, read_json, read_parquet
+from lerobot_tavis.readers import expect, get, get_integer, read_json, read_parquet
 
 INFO = "meta/info.json"
 FRAME_COLUMNS = ("episode_index", "frame_index", "timestamp")  # what `episode_frames` needs in every data file
@@ -28,7 +27,7 @@ def dataset_info(root: str | Path) -> dict:
     if not isinstance(info, dict):
         raise InputError(f"{path}: must be a JSON object, got {type(info).__name__}")
     get(info, "codebase_version", "str", path)
-    checked(lambda v: checks.integer("fps", v, 1), info.get("fps"), path, "fps")
+    info["fps"] = get_integer(info, "fps", path, minimum=1)
     get(info, "robot_type", "str", path, optional=True)
     get(info, "data_path", "str", path)
     for key, feature in get(info, "features", "object", path).items():

@@ -16,12 +16,12 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 
 import numpy as np
 
-from lerobot_tavis import canonical, checks
+from lerobot_tavis import canonical
 from lerobot_tavis.atomic import atomic_path, write_text
 from lerobot_tavis.envs.robots import robot_info
 from lerobot_tavis.envs.tasks.catalog import parse_split, task_info
 from lerobot_tavis.errors import InputError, PathNotFoundError, TavisError
-from lerobot_tavis.readers import KINDS, checked, get, read_json
+from lerobot_tavis.readers import KINDS, checked, get, get_integer, read_json
 
 FORMAT = "tavis-raw"
 FORMAT_VERSION = 1
@@ -199,10 +199,8 @@ class Manifest:
             robot = checked(robot_info, get(document, "robot", "str", path), path, "robot").name
             split = get(document, "split", "str", path)
             checked(parse_split, split, path, "split")
-            fps = checked(lambda v: checks.integer("fps", v, 1), document.get("fps"), path, "fps")
-            seed_start = checked(lambda v: checks.integer("seed_start", v, 0), document.get("seed_start"), path,
-                                 "seed_start")
-            manifest = cls(robot, split, fps, seed_start)
+            manifest = cls(robot, split, get_integer(document, "fps", path, minimum=1),
+                           get_integer(document, "seed_start", path))
             for group, kept in (("episodes", True), ("discarded", False)):
                 for i, item in enumerate(get(document, group, "list", path)):
                     manifest.add(_entry(item, path, f"{group}[{i}].", kept))
@@ -247,12 +245,11 @@ def _entry(item, path: Path, where: str, kept: bool) -> ManifestEntry:
     if not isinstance(item, dict):
         raise InputError(f"{path}: {where.rstrip('.')} must be an object, got {item!r}")
     task = checked(task_info, get(item, "task", "str", path, where), path, f"{where}task").name
-    seed = checked(lambda v: checks.integer("seed", v, 0), item.get("seed"), path, f"{where}seed")
-    n_steps = checked(lambda v: checks.integer("n_steps", v, 1 if kept else 0), item.get("n_steps"), path,
-                      f"{where}n_steps")
+    seed = get_integer(item, "seed", path, where)
+    n_steps = get_integer(item, "n_steps", path, where, minimum=1 if kept else 0)
     success = get(item, "success", "bool", path, where)
-    file, sha256 = get(item, "file", "str", path, where, optional=not kept), get(item, "sha256", "str", path, where,
-                                                                                  optional=not kept)
+    file = get(item, "file", "str", path, where, optional=not kept)
+    sha256 = get(item, "sha256", "str", path, where, optional=not kept)
     if not kept and (file, sha256) != (None, None):
         raise InputError(f"{path}: {where}file and sha256 must be null for a discarded seed")
     if kept:

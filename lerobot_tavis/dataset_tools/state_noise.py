@@ -31,13 +31,13 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_tavis import canonical, checks
+from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools.features import STATE_KEY
 from lerobot_tavis.dataset_tools.frames import INFO, check_files, dataset_info
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.transforms import quat_angles_rad
 from lerobot_tavis.errors import FieldError, InputError, PathExistsError, PathNotFoundError
-from lerobot_tavis.readers import checked, read_parquet
+from lerobot_tavis.readers import get_integer, read_parquet
 
 NOISE_RECORD = "meta/state_noise.json"
 STATS_PREFIX = f"stats/{STATE_KEY}/"  # per-episode statistics columns in meta/episodes/*.parquet
@@ -119,8 +119,7 @@ def _check_source(source: Path) -> int:
     info = dataset_info(source)
     check_files(source)
     version, features = info["codebase_version"], info["features"]
-    frames = checked(lambda v: checks.integer("total_frames", v, 0), info.get("total_frames"), source / INFO,
-                     "total_frames")
+    frames = get_integer(info, "total_frames", source / INFO)
     if version != "v3.0":
         raise InputError(f"source_root {source} is a LeRobotDataset {version}, not v3.0")
     if frames < 1:

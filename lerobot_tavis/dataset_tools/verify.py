@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_tavis import canonical, checks
+from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG
 from lerobot_tavis.dataset_tools.frames import (INFO, check_camera_frames, check_files, column_array, dataset_info,
@@ -25,7 +25,7 @@ from lerobot_tavis.dataset_tools.frames import (INFO, check_camera_frames, check
 from lerobot_tavis.envs.robots import robot_info
 from lerobot_tavis.envs.tasks.catalog import parse_split, task_info
 from lerobot_tavis.errors import InputError, TavisError
-from lerobot_tavis.readers import checked, expect, get, read_json
+from lerobot_tavis.readers import checked, expect, get, get_integer, read_json
 
 TOLERANCE_M = 0.015  # replayed hands stay within 1.3 cm of a 60 Hz recording at 20 Hz (measured, 20 episodes)
 HOLD_S = 1.0
@@ -79,11 +79,9 @@ def _conversion_log(path: Path) -> tuple[dict[int, dict], bool]:
     for i, entry in enumerate(get(log, "episodes", "list", path)):
         where = f"episodes[{i}]."
         expect(entry, "object", path, where.rstrip("."))
-        index = checked(lambda v: checks.integer("episode_index", v, 0), entry.get("episode_index"), path,
-                        f"{where}episode_index")
-        checked(task_info, get(entry, "task", "str", path, where), path, f"{where}task")
-        checked(lambda v: checks.integer("seed", v, 0), entry.get("seed"), path, f"{where}seed")
-        entries[index] = entry
+        index = get_integer(entry, "episode_index", path, where)
+        task = checked(task_info, get(entry, "task", "str", path, where), path, f"{where}task").name
+        entries[index] = {"episode_index": index, "task": task, "seed": get_integer(entry, "seed", path, where)}
     return entries, bool(get(log, "zero_neck", "bool", path, optional=True))
 
 
