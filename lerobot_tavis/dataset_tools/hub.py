@@ -157,6 +157,7 @@ def _check_dataset_root(root: str | Path) -> Path:
     if not (root / "meta" / "info.json").is_file() or not any(root.glob("data/*/*.parquet")):
         raise PathNotFoundError(f"{root} is not a LeRobotDataset: it needs meta/info.json and data/*/*.parquet "
                                 "(a dataset written and finalize()d by LeRobot)")
+    check_files(root)
     return root
 
 

@@ -1,5 +1,5 @@
-"""Converted datasets with a damaged, missing or ill-typed file: `tavis verify-dataset`, `noise-state` and `pull`
-(its local copy) exit with one line naming the file (and the field or the video frame), and write nothing."""
+"""Converted datasets with a damaged, missing or ill-typed file: `tavis verify-dataset`, `noise-state`, `pull` (its
+local copy) and `push` exit with one line naming the file (and the field or the video frame), and write nothing."""
 
 import json
 import os
@@ -115,3 +115,10 @@ def test_pull_names_a_damaged_local_file(dataset_copy, refused, monkeypatch, dam
     assert message.startswith(f"tavis pull: error: {dataset_copy / damaged}: not a ")
     assert message.endswith("; remove it to download it again")
     assert _files(dataset_copy) == before
+
+
+def test_push_names_a_damaged_file_before_uploading(dataset_copy, refused, monkeypatch):
+    monkeypatch.setenv("HF_HUB_OFFLINE", "1")
+    _truncate(dataset_copy / DATA)
+    assert refused(["push", str(dataset_copy), "--repo-id", "local/faults"]).startswith(
+        f"tavis push: error: {dataset_copy / DATA}: not a readable Parquet file")
