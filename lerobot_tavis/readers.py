@@ -64,8 +64,8 @@ def read_json_lines(path: str | Path) -> Iterator[tuple[int, object]]:
             raise InputError(f"{path}:{number}: not a JSON line ({error.msg})") from None
 
 
-def read_parquet(path: str | Path, columns: list[str] | None = None):
-    """A Parquet file as a pyarrow Table (all of it, or `columns`), every page read."""
+def read_parquet(path: str | Path):
+    """A Parquet file as a pyarrow Table, every page read."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -73,7 +73,7 @@ def read_parquet(path: str | Path, columns: list[str] | None = None):
     if not path.is_file():
         raise PathNotFoundError(f"{path}: missing")
     try:
-        return pq.read_table(path, columns=columns)
+        return pq.read_table(path)
     except (pa.ArrowException, OSError) as error:
         reason = re.sub(r"^Could not open Parquet input source '.*?': ", "", str(error).splitlines()[0]).split(". ")[0]
         raise InputError(f"{path}: not a readable Parquet file ({reason})") from None

@@ -89,25 +89,37 @@ def check_camera_frames(root: str | Path, info: dict, episodes: Mapping) -> None
 
 
 def _check_video_frames(root: Path, info: dict, key: str, episodes: Mapping) -> None:
+    """Every frame of camera `key` of `episodes` decoded: a frame within half a frame period of each row's time."""
     import pandas as pd
 
     meta_paths = sorted((root / "meta/episodes").rglob("*.parquet"))
     if not meta_paths:
         raise PathNotFoundError(f"{root / 'meta/episodes'}: no episode metadata (Parquet files)")
     columns = [f"videos/{key}/{name}" for name in ("chunk_index", "file_index", "from_timestamp")]
-    meta = pd.concat([read_parquet(path).to_pandas() for path in meta_paths]).set_index("episode_index")
+    meta = pd.concat([read_parquet(path).to_pandas() for path in meta_paths])
+    if "episode_index" not in meta.columns:
+        raise InputError(f"{root / 'meta/episodes'}: not LeRobot episode metadata (no column episode_index)")
+    meta = meta.set_index("episode_index")
     tolerance_s = 0.5 / info["fps"]
     decoded: dict[Path, tuple[np.ndarray, str | None]] = {}
     for index, rows in episodes.items():
         if index not in meta.index or any(column not in meta.columns for column in columns):
             raise InputError(f"{root / 'meta/episodes'}: no video of {key} for episode {index}")
-        chunk, file, start_s = (meta.loc[index, column] for column in columns)
-        video = root / info["video_path"].format(video_key=key, chunk_index=int(chunk), file_index=int(file))
+        try:
+            chunk, file, start_s = (cast(meta.loc[index, column]) for cast, column in zip((int, int, float), columns))
+        except (TypeError, ValueError):
+            raise InputError(f"{root / 'meta/episodes'}: episode {index}: {', '.join(columns)} must be "
+                             "numbers") from None
+        try:
+            video = root / info["video_path"].format(video_key=key, chunk_index=chunk, file_index=file)
+        except (KeyError, IndexError, ValueError) as error:
+            raise InputError(f"{root / INFO}: video_path {info['video_path']!r} is not a LeRobot path pattern "
+                             f"({type(error).__name__}: {error})") from None
         if video not in decoded:
             decoded[video] = _frame_times(video)
         times, failure = decoded[video]
         for frame, timestamp in zip(rows["frame_index"], rows["timestamp"]):
-            wanted_s = float(start_s) + float(timestamp)
+            wanted_s = start_s + float(timestamp)
             if not (len(times) and np.min(np.abs(times - wanted_s)) <= tolerance_s):
                 reason = failure or (f"not in the video, which holds {len(times)} frames"
                                      + (f" up to {times.max():.2f} s" if len(times) else ""))
