@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 
 from lerobot_tavis.atomic import atomic_path, write_bytes
+from lerobot_tavis.errors import InputError
 
 
 def encode_mp4(frames: Iterable[np.ndarray], fps: int) -> bytes:
@@ -42,12 +43,20 @@ def write_mp4(path: str | Path, frames: list[np.ndarray], fps: int) -> Path:
 
 
 def iter_mp4(path: str | Path) -> Iterator[np.ndarray]:
-    """The RGB uint8 frames (H, W, 3) of a video file, decoded one at a time."""
+    """The RGB uint8 frames (H, W, 3) of a video file, decoded one at a time; a file that is not a video or stops
+    decoding is an InputError naming it and the frame."""
     import av  # PyAV: only where videos are read
 
-    with av.open(str(path)) as container:
-        for frame in container.decode(video=0):
-            yield frame.to_ndarray(format="rgb24")
+    decoded = 0
+    try:
+        with av.open(str(path)) as container:
+            if not container.streams.video:
+                raise InputError(f"{path}: not a video (no video stream)")
+            for frame in container.decode(video=0):
+                yield frame.to_ndarray(format="rgb24")
+                decoded += 1
+    except av.FFmpegError as error:
+        raise InputError(f"{path}: frame {decoded} cannot be decoded ({error.strerror or error})") from None
 
 
 def write_png(path: str | Path, rgb: np.ndarray) -> Path:

@@ -15,6 +15,7 @@ from urllib.parse import quote
 
 from lerobot_tavis import checks
 from lerobot_tavis.dataset_tools.features import JOINT_POS_KEY, SPLIT_KEY, STATE_KEY, TASK_NAME_KEY
+from lerobot_tavis.dataset_tools.frames import check_files
 from lerobot_tavis.envs.tasks.catalog import TASKS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError, TavisError
 
@@ -133,13 +134,20 @@ def push_dataset(root: str | Path, repo_id: str, *, private: bool = False, branc
 def pull_dataset(repo_id: str, root: str | Path | None = None, revision: str | None = None):
     """The `LeRobotDataset` `repo_id` from the Hub, downloaded into `root` (default: LeRobot's Hub cache).
 
-    A complete copy already in `root` is loaded without contacting the Hub.
+    A complete copy already in `root` is loaded without contacting the Hub. The metadata and data files already
+    there are read first: a damaged one (e.g. a download cut short) is an InputError naming it.
     """
     checks.repo_id(repo_id)
     from lerobot.datasets import LeRobotDataset
+    from lerobot.utils.constants import HF_LEROBOT_HOME
 
     from lerobot_tavis.dataset_tools.quiet import video_backend
 
+    local = Path(root) if root is not None else HF_LEROBOT_HOME / repo_id
+    try:
+        check_files(local)
+    except InputError as error:
+        raise InputError(f"{error}; remove it to download it again") from None
     with _hub_errors(repo_id):
         return LeRobotDataset(repo_id, root=root, revision=revision, video_backend=video_backend())
 
@@ -149,6 +157,7 @@ def _check_dataset_root(root: str | Path) -> Path:
     if not (root / "meta" / "info.json").is_file() or not any(root.glob("data/*/*.parquet")):
         raise PathNotFoundError(f"{root} is not a LeRobotDataset: it needs meta/info.json and data/*/*.parquet "
                                 "(a dataset written and finalize()d by LeRobot)")
+    check_files(root)
     return root
 
 

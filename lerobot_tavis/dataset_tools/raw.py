@@ -9,20 +9,27 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import zipfile
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath, PureWindowsPath
 
 import numpy as np
 
 from lerobot_tavis import canonical
 from lerobot_tavis.atomic import atomic_path, write_text
-from lerobot_tavis.errors import PathNotFoundError, TavisError
+from lerobot_tavis.envs.robots import robot_info
+from lerobot_tavis.envs.tasks.catalog import parse_split, task_info
+from lerobot_tavis.errors import InputError, PathNotFoundError, TavisError
+from lerobot_tavis.readers import KINDS, checked, get, get_integer, read_json
 
 FORMAT = "tavis-raw"
 FORMAT_VERSION = 1
 MANIFEST_NAME = "manifest.json"
 ARRAYS = ("actions", "qpos", "qvel", "task_state")
+# The fields of a raw file's metadata (besides format and version) and what each must be (`readers.KINDS`).
+METADATA_KINDS = {"robot": "str", "task": "str", "split": "str", "seed": "int", "prompt": "str", "fps": "int",
+                  "success": "bool"}
 
 
 class RawEpisodeError(TavisError, ValueError):
@@ -73,36 +80,48 @@ def load_episode(path: str | Path, sha256: str | None = None) -> RawEpisode:
     if sha256 is not None and file_sha256(path) != sha256:
         raise RawEpisodeError(f"{path}: checksum does not match the manifest (the file is corrupt or was changed)")
     try:
+        return _read_episode(path)
+    except RawEpisodeError as error:
+        raise RawEpisodeError(f"{path}: {error}") from None
+
+
+def _read_episode(path: Path) -> RawEpisode:
+    """The episode in `path`; RawEpisodeError saying what is wrong with it (without the path)."""
+    try:
         with np.load(path, allow_pickle=False) as archive:
             metadata = json.loads(str(archive["metadata"]))
             arrays = {name: np.array(archive[name]) for name in ARRAYS}
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as error:
-        raise RawEpisodeError(f"{path}: not a readable raw episode ({type(error).__name__}: {error})") from None
-    if metadata.get("format") != FORMAT or metadata.get("version") != FORMAT_VERSION:
-        raise RawEpisodeError(f"{path}: not a {FORMAT} v{FORMAT_VERSION} file")
-    episode = RawEpisode(**{k: v for k, v in metadata.items() if k not in ("format", "version")}, **arrays)
-    _check_shapes(path, episode)
+        raise RawEpisodeError(f"not a readable raw episode ({type(error).__name__}: {error})") from None
+    if not isinstance(metadata, dict) or metadata.get("format") != FORMAT or metadata.get("version") != FORMAT_VERSION:
+        raise RawEpisodeError(f"not a {FORMAT} v{FORMAT_VERSION} file")
+    fields = {}
+    for name, kind in METADATA_KINDS.items():
+        value = metadata.get(name)
+        if not KINDS[kind][1](value):
+            raise RawEpisodeError(f"its metadata's {name} must be {KINDS[kind][0]}, got {value!r}")
+        fields[name] = value
+    episode = RawEpisode(**fields, **arrays)
+    _check_arrays(episode)
     return episode
 
 
-def read_header(path: str | Path) -> dict:
-    """A raw file's own record of its episode (robot, task, split, seed, fps, success, n_steps), without its states."""
-    try:
-        with np.load(path, allow_pickle=False) as archive:
-            return json.loads(str(archive["metadata"])) | {"n_steps": len(archive["actions"])}
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as error:
-        raise RawEpisodeError(f"{path}: not a readable raw episode ({type(error).__name__}: {error})") from None
-
-
-def _check_shapes(path: Path, episode: RawEpisode) -> None:
+def _check_arrays(episode: RawEpisode) -> None:
+    """Each array holds finite numbers, `actions` (T, 19) with T > 0, the states T + 1 rows."""
+    for name in ARRAYS:
+        array = getattr(episode, name)
+        if not np.issubdtype(array.dtype, np.number):
+            raise RawEpisodeError(f"{name} must hold numbers, got {array.dtype}")
+        bad = np.argwhere(~np.isfinite(array))
+        if len(bad):
+            raise RawEpisodeError(f"{name} holds a non-finite value ({array[tuple(bad[0])]}) at row {bad[0][0]}")
     steps = episode.n_steps
     if episode.actions.ndim != 2 or episode.actions.shape[1] != canonical.ACTION_DIM or steps == 0:
-        raise RawEpisodeError(f"{path}: actions must be (T, {canonical.ACTION_DIM}) with T > 0, "
-                              f"got {episode.actions.shape}")
+        raise RawEpisodeError(f"actions must be (T, {canonical.ACTION_DIM}) with T > 0, got {episode.actions.shape}")
     for name in ("qpos", "qvel", "task_state"):
         rows = len(getattr(episode, name))
         if rows != steps + 1:
-            raise RawEpisodeError(f"{path}: {name} must have {steps + 1} rows (T + 1), got {rows}")
+            raise RawEpisodeError(f"{name} must have {steps + 1} rows (T + 1), got {rows}")
 
 
 def _content_sha256(document: dict) -> str:
@@ -163,25 +182,36 @@ class Manifest:
 
     @classmethod
     def load(cls, raw_dir: str | Path) -> Manifest:
+        """The manifest of the `tavis record` output `raw_dir`; RawEpisodeError naming the field when it was edited
+        by hand or holds what no recording writes (e.g. an episode file outside `raw_dir`)."""
         path = Path(raw_dir) / MANIFEST_NAME
         if not path.is_file():
             raise PathNotFoundError(f"{path} not found: is {raw_dir} a directory written by `tavis record`?")
+        document = read_json(path)
+        if not (isinstance(document, dict) and document.get("format") == FORMAT
+                and document.get("version") == FORMAT_VERSION):
+            raise RawEpisodeError(f"{path}: not a {FORMAT} v{FORMAT_VERSION} manifest")
+        recorded = document.pop("sha256", None)
+        if recorded is not None and recorded != _content_sha256(document):
+            raise RawEpisodeError(f"{path}: changed since `tavis record` wrote it (its checksum no longer matches "
+                                  "its content); restore it or record again")
         try:
-            document = json.loads(path.read_text())
-            recorded = document.pop("sha256", None)
-            if recorded is not None and recorded != _content_sha256(document):
-                raise RawEpisodeError(f"{path}: changed since `tavis record` wrote it (its checksum no longer matches "
-                                      "its content); restore it or record again")
-            return cls(robot=document["robot"], split=document["split"], fps=int(document["fps"]),
-                       seed_start=int(document["seed_start"]),
-                       episodes=[ManifestEntry(**e) for e in document["episodes"]],
-                       discarded=[ManifestEntry(**e) for e in document["discarded"]])
-        except (ValueError, KeyError, TypeError) as error:
-            raise RawEpisodeError(f"{path}: not a valid manifest ({type(error).__name__}: {error})") from None
+            robot = checked(robot_info, get(document, "robot", "str", path), path, "robot").name
+            split = get(document, "split", "str", path)
+            checked(parse_split, split, path, "split")
+            manifest = cls(robot, split, get_integer(document, "fps", path, minimum=1),
+                           get_integer(document, "seed_start", path))
+            for group, kept in (("episodes", True), ("discarded", False)):
+                for i, item in enumerate(get(document, group, "list", path)):
+                    manifest.add(_entry(item, path, f"{group}[{i}].", kept))
+        except InputError as error:
+            raise RawEpisodeError(str(error)) from None
+        return manifest
 
     def damaged(self, raw_dir: str | Path) -> dict[str, str]:
-        """Kept episodes that cannot be trusted, {file: problem}: a missing file, a failed checksum, a second entry
-        for the same file or (task, seed), or a field where the manifest and the file's own record disagree."""
+        """Kept episodes that cannot be trusted, {file: problem}: a missing or unreadable file, a failed checksum, a
+        second entry for the same file or (task, seed), or a field where the manifest and the file's own record
+        disagree."""
         problems, seen = {}, set()
         for entry in self.episodes:
             path = Path(raw_dir) / entry.file
@@ -192,15 +222,40 @@ class Manifest:
             elif file_sha256(path) != entry.sha256:
                 problems[entry.file] = "checksum mismatch"
             else:
-                problems |= self._disagreement(path, entry)
+                try:
+                    problems |= self._disagreement(_read_episode(path), entry)
+                except RawEpisodeError as error:
+                    problems[entry.file] = str(error)
             seen |= {entry.file, (entry.task, entry.seed)}
         return problems
 
-    def _disagreement(self, path: Path, entry: ManifestEntry) -> dict[str, str]:
-        header = read_header(path)
+    def _disagreement(self, episode: RawEpisode, entry: ManifestEntry) -> dict[str, str]:
         claimed = {"robot": self.robot, "split": self.split, "fps": self.fps, "task": entry.task, "seed": entry.seed,
                    "success": entry.success, "n_steps": entry.n_steps}
         for field_name, value in claimed.items():
-            if header.get(field_name) != value:
-                return {entry.file: f"{field_name}: the manifest says {value!r}, the file {header.get(field_name)!r}"}
+            found = getattr(episode, field_name)
+            if found != value:
+                return {entry.file: f"{field_name}: the manifest says {value!r}, the file {found!r}"}
         return {}
+
+
+def _entry(item, path: Path, where: str, kept: bool) -> ManifestEntry:
+    """One manifest entry (`where`: its place, e.g. "episodes[3]."); a kept one names its file, a path inside the
+    raw directory, and that file's SHA-256; a discarded one neither."""
+    if not isinstance(item, dict):
+        raise InputError(f"{path}: {where.rstrip('.')} must be an object, got {item!r}")
+    task = checked(task_info, get(item, "task", "str", path, where), path, f"{where}task").name
+    seed = get_integer(item, "seed", path, where)
+    n_steps = get_integer(item, "n_steps", path, where, minimum=1 if kept else 0)
+    success = get(item, "success", "bool", path, where)
+    file = get(item, "file", "str", path, where, optional=not kept)
+    sha256 = get(item, "sha256", "str", path, where, optional=not kept)
+    if not kept and (file, sha256) != (None, None):
+        raise InputError(f"{path}: {where}file and sha256 must be null for a discarded seed")
+    if kept:
+        relative = PurePosixPath(file)
+        if not file or relative.is_absolute() or PureWindowsPath(file).is_absolute() or ".." in relative.parts:
+            raise InputError(f"{path}: {where}file must be a path inside the raw directory, got {file!r}")
+        if not re.fullmatch(r"[0-9a-f]{64}", sha256):
+            raise InputError(f"{path}: {where}sha256 must be 64 hexadecimal digits, got {sha256!r}")
+    return ManifestEntry(task, seed, success, n_steps, file, sha256)

@@ -33,9 +33,11 @@ import numpy as np
 
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools.features import STATE_KEY
+from lerobot_tavis.dataset_tools.frames import INFO, check_files, dataset_info
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.transforms import quat_angles_rad
 from lerobot_tavis.errors import FieldError, InputError, PathExistsError, PathNotFoundError
+from lerobot_tavis.readers import get_integer, read_parquet
 
 NOISE_RECORD = "meta/state_noise.json"
 STATS_PREFIX = f"stats/{STATE_KEY}/"  # per-episode statistics columns in meta/episodes/*.parquet
@@ -65,7 +67,8 @@ def write_state_noise_copy(source_root: str | Path, out_root: str | Path, positi
     Returns the settings and the measured shifts (also written to `meta/state_noise.json`). Raises FieldError for a
     bad noise scale, seed or out_root, PathNotFoundError for a missing source, PathExistsError for an existing
     out_root, InputError for a source that is not a LeRobotDataset v3.0 with a 19-D float32 observation.state (or
-    is a noisy copy already); nothing is written then, nor when the copy fails half-way."""
+    is a noisy copy already, or has a damaged metadata or data file, which it names); nothing is written then, nor
+    when the copy fails half-way."""
     position_m, rotation_deg = _noise_scale("position_m", position_m), _noise_scale("rotation_deg", rotation_deg)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise FieldError("seed", f"must be an integer >= 0, got {seed!r}")
@@ -110,14 +113,13 @@ def _noise_scale(field: str, value) -> float:
 
 def _check_source(source: Path) -> int:
     """The number of frames of the dataset at `source`, refused unless it is a LeRobotDataset v3.0 with a canonical
-    19-D float32 `observation.state` and not itself a noisy copy."""
+    19-D float32 `observation.state`, whose metadata and data files all read whole, and not itself a noisy copy."""
     if not source.is_dir():
         raise PathNotFoundError(f"source_root {source} is not a directory")
-    try:
-        info = json.loads((source / "meta/info.json").read_text())
-        version, features, frames = info["codebase_version"], info["features"], int(info["total_frames"])
-    except (OSError, ValueError, KeyError, TypeError) as error:
-        raise InputError(f"source_root {source} is not a LeRobotDataset: meta/info.json unreadable ({error})") from None
+    info = dataset_info(source)
+    check_files(source)
+    version, features = info["codebase_version"], info["features"]
+    frames = get_integer(info, "total_frames", source / INFO)
     if version != "v3.0":
         raise InputError(f"source_root {source} is a LeRobotDataset {version}, not v3.0")
     if frames < 1:
@@ -157,12 +159,11 @@ def _rewrite_data_files(source: Path, staging: Path, shift_m: np.ndarray,
     """Write each data file of `source` into `staging` with its states perturbed by the noise rows of its frames'
     `index`; returns the source's and the new states per episode index, in frame order."""
     import pyarrow as pa
-    import pyarrow.parquet as pq
     from lerobot.datasets.io_utils import write_table_one_row_group_per_episode
 
     originals, noisy = defaultdict(list), defaultdict(list)
     for path in sorted((source / "data").rglob("*.parquet")):
-        table = pq.read_table(path)
+        table = read_parquet(path)
         column = table.schema.get_field_index(STATE_KEY)
         states = table.column(column).combine_chunks().flatten().to_numpy().reshape(-1, canonical.ACTION_DIM)
         index = table.column("index").to_numpy()
@@ -193,7 +194,7 @@ def _rewrite_state_stats(source: Path, staging: Path, noisy: dict[int, np.ndarra
 
     per_episode = {episode: get_feature_stats(states, axis=0, keepdims=False) for episode, states in noisy.items()}
     for path in sorted((staging / "meta/episodes").rglob("*.parquet")):
-        table = pq.read_table(path)
+        table = read_parquet(path)
         episodes = table.column("episode_index").to_pylist()
         for name in [name for name in table.column_names if name.startswith(STATS_PREFIX)]:
             key, field = name[len(STATS_PREFIX):], table.schema.field(name)

@@ -10,7 +10,6 @@ few millimetres behind, so the last action is held for `hold_s` more before succ
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -21,8 +20,12 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG
-from lerobot_tavis.dataset_tools.frames import column_array, episode_frames
-from lerobot_tavis.errors import TavisError
+from lerobot_tavis.dataset_tools.frames import (INFO, check_camera_frames, check_files, column_array, dataset_info,
+                                                episode_frames)
+from lerobot_tavis.envs.robots import robot_info
+from lerobot_tavis.envs.tasks.catalog import parse_split, task_info
+from lerobot_tavis.errors import InputError, TavisError
+from lerobot_tavis.readers import checked, expect, get, get_integer, read_json
 
 TOLERANCE_M = 0.015  # replayed hands stay within 1.3 cm of a 60 Hz recording at 20 Hz (measured, 20 episodes)
 HOLD_S = 1.0
@@ -44,30 +47,59 @@ class EpisodeCheck:
 def verify_dataset(root: Path, episodes: Sequence[int] | None = None, hold_s: float = HOLD_S,
                    action_shift: int = 0) -> list[EpisodeCheck]:
     """Replay `episodes` (default: all) of the dataset at `root`; `action_shift` frames misalign actions on purpose
-    (the check's own test: a shift of one frame must fail)."""
-    from lerobot.datasets.lerobot_dataset import LeRobotDatasetMetadata
-
-    log_path = Path(root) / CONVERSION_LOG
+    (the check's own test: a shift of one frame must fail). Every metadata and data file is read and every camera
+    frame of the chosen episodes decoded first: a damaged file is an InputError naming it (and the frame)."""
+    root = Path(root)
+    log_path = root / CONVERSION_LOG
     if not log_path.is_file():
         raise TavisError(f"{root}: no {CONVERSION_LOG}; only datasets written by `tavis convert` can be replayed")
-    conversion = json.loads(log_path.read_text())
-    log = {entry["episode_index"]: entry for entry in conversion["episodes"]}
-    meta = LeRobotDatasetMetadata("local/verify", root=root)
+    check_files(root)
+    info = dataset_info(root)
+    robot = checked(robot_info, info.get("robot_type"), root / INFO, "robot_type").name
+    log, zero_neck = _conversion_log(log_path)
     chosen = sorted(log) if episodes is None else list(episodes)
     unknown = [index for index in chosen if index not in log]
     if unknown:
         raise TavisError(f"{root}: no episodes {unknown}; it holds 0..{len(log) - 1}")
-    zero_neck = conversion.get("zero_neck", False)
-    columns = _episode_columns(root)
-    return [_replay(meta.robot_type, meta.fps, log[index], columns[index], zero_neck, hold_s, action_shift)
+    frames = episode_frames(root)
+    absent = [index for index in chosen if index not in frames]
+    if absent:
+        raise InputError(f"{root / 'data'}: no frames of episodes {absent}, which {CONVERSION_LOG} lists")
+    columns = {index: _episode_columns(frames[index], index) for index in chosen}
+    check_camera_frames(root, info, {index: frames[index] for index in chosen})
+    return [_replay(robot, info["fps"], log[index], columns[index], zero_neck, hold_s, action_shift)
             for index in chosen]
 
 
-def _episode_columns(root: Path) -> dict[int, dict[str, np.ndarray]]:
-    """Per episode index: its frames' state, action and split, in frame order."""
-    return {index: {"state": column_array(rows, ft.STATE_KEY), "action": column_array(rows, ft.ACTION_KEY),
-                    "split": str(rows[ft.SPLIT_KEY].iloc[0])}
-            for index, rows in episode_frames(root).items()}
+def _conversion_log(path: Path) -> tuple[dict[int, dict], bool]:
+    """The conversion log's episodes by index ({episode_index, task, seed}) and its zero_neck setting."""
+    log = read_json(path)
+    expect(log, "object", path, "the log")
+    entries = {}
+    for i, entry in enumerate(get(log, "episodes", "list", path)):
+        where = f"episodes[{i}]."
+        expect(entry, "object", path, where.rstrip("."))
+        index = get_integer(entry, "episode_index", path, where)
+        task = checked(task_info, get(entry, "task", "str", path, where), path, f"{where}task").name
+        entries[index] = {"episode_index": index, "task": task, "seed": get_integer(entry, "seed", path, where)}
+    return entries, bool(get(log, "zero_neck", "bool", path, optional=True))
+
+
+def _episode_columns(rows, index: int) -> dict[str, np.ndarray | str]:
+    """An episode's frames' state and action (frames, 19), finite, and its split."""
+    where = f"{rows['data_file'].iloc[0]}: episode {index}"
+    columns = {}
+    for key in (ft.STATE_KEY, ft.ACTION_KEY):
+        try:
+            values = column_array(rows, key).astype(np.float64)
+        except (KeyError, ValueError, TypeError):
+            values = None
+        if values is None or values.shape != (len(rows), canonical.ACTION_DIM) or not np.isfinite(values).all():
+            raise InputError(f"{where}: {key} must be {canonical.ACTION_DIM} finite numbers per frame")
+        columns[key] = values
+    split = expect(rows[ft.SPLIT_KEY].iloc[0] if ft.SPLIT_KEY in rows else None, "str", where, ft.SPLIT_KEY)
+    checked(parse_split, split, where, ft.SPLIT_KEY)
+    return {"state": columns[ft.STATE_KEY], "action": columns[ft.ACTION_KEY], "split": split}
 
 
 def _replay(robot: str, fps: int, entry: dict, columns: dict, zero_neck: bool, hold_s: float,

@@ -4,16 +4,31 @@ rate, with its Wilson 95% interval, against the training step."""
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
 
 from lerobot_tavis.atomic import write_text
-from lerobot_tavis.errors import InputError, PathNotFoundError
+from lerobot_tavis.errors import PathNotFoundError
 from lerobot_tavis.eval.report import rate_text, save_figure
+from lerobot_tavis.readers import expect, get, read_json
 
 STEP_FOLDER = re.compile(r"step_(\d+)")
 TABLE_NAME, PLOT_NAME = "checkpoints.md", "checkpoints.png"
+# What the curve reads from every cell of a results.json (`eval.report`) and what each must be (`readers.KINDS`).
+CELL_FIELDS = {"task": "str", "split": "str", "n": "int", "success_rate": "number", "ci_low": "number",
+               "ci_high": "number"}
+
+
+def read_results(path: Path) -> dict:
+    """A `tavis report` results.json, checked for what the curve reads; an error names the file and the field."""
+    report = read_json(path)
+    expect(report, "object", path, "the report")
+    for i, cell in enumerate(get(report, "cells", "list", path)):
+        expect(cell, "object", path, f"cells[{i}]")
+        for name, kind in CELL_FIELDS.items():
+            get(cell, name, kind, path, f"cells[{i}].")
+        get(cell, "galt_median_s", "number", path, f"cells[{i}].", optional=True)
+    return report
 
 
 def checkpoint_reports(root: Path) -> list[tuple[int, dict]]:
@@ -27,11 +42,7 @@ def checkpoint_reports(root: Path) -> list[tuple[int, dict]]:
         match = STEP_FOLDER.fullmatch(folder.name)
         if match is None or not (folder / "results.json").is_file():
             continue
-        try:
-            report = json.loads((folder / "results.json").read_text())
-        except json.JSONDecodeError as error:
-            raise InputError(f"{folder / 'results.json'}: not JSON ({error.msg})") from None
-        reports.append((int(match[1]), report))
+        reports.append((int(match[1]), read_results(folder / "results.json")))
     if not reports:
         raise PathNotFoundError(f"{root}: no step_<N>/results.json below it (one `tavis eval` output per checkpoint)")
     return sorted(reports, key=lambda item: item[0])

@@ -26,6 +26,7 @@ from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.metrics.registry import episode_metrics
 from lerobot_tavis.metrics.stats import wilson_interval
+from lerobot_tavis.readers import expect, get, read_json, read_json_lines
 
 EVAL_INFO_NAME = "eval_info.json"
 DELTA_SPLITS = ("ood_spatial", "ood_visual")  # the report gives id minus each, per task
@@ -101,35 +102,47 @@ class Cell:
         }
 
 
-# What the report reads from every episode record (the episode log writes more).
-RECORD_FIELDS = ("robot", "suite", "task", "task_id", "split", "camera_mode", "seed", "success")
+# What the report reads from every episode record and what each must be (`readers.KINDS`); the log writes more.
+RECORD_FIELDS = {"robot": "str", "suite": "str", "task": "str", "task_id": "int", "split": "str",
+                 "camera_mode": "str", "seed": "int", "success": "bool"}
+# Fields the report and the video annotation read where present, null allowed; besides them, every `<name>_s` field
+# (metric times, seconds) must be a number and every `<name>_reason` a text.
+OPTIONAL_RECORD_FIELDS = {"length_steps": "int", "prompt": "str", "instability": "str", "reach": "object"}
+# The `reach` fields the report reads (metres): always there, and there or null in older logs.
+REACH_FIELDS, OPTIONAL_REACH_FIELDS = ("closest_hand_m", "target_moved_m"), ("closest_hand_other_m",
+                                                                             "first_grasp_xy_m", "command_gap_m")
 
 
 def read_episode_log(path: Path) -> list[dict]:
+    """The records of an episode log (`eval.episode_log`), each checked for the fields the report reads; an error
+    names the file, the line and the field."""
     records = []
-    for number, line in enumerate(path.read_text().splitlines(), start=1):
-        if not line.strip():
-            continue
-        try:
-            record = json.loads(line)
-        except json.JSONDecodeError as error:
-            raise InputError(f"{path}:{number}: not a JSON line ({error.msg})") from None
-        missing = [name for name in RECORD_FIELDS if not isinstance(record, dict) or name not in record]
+    for number, record in read_json_lines(path):
+        where = f"{path}:{number}"
+        if not isinstance(record, dict):
+            raise InputError(f"{where}: not an episode record (a JSON object), got {type(record).__name__}")
+        missing = [name for name in RECORD_FIELDS if name not in record]
         if missing:
-            raise InputError(f"{path}:{number}: not an episode record (missing {', '.join(missing)})")
+            raise InputError(f"{where}: not an episode record (missing {', '.join(missing)})")
+        for name, kind in RECORD_FIELDS.items():
+            expect(record[name], kind, where, name)
+        for name, value in record.items():
+            kind = OPTIONAL_RECORD_FIELDS.get(name) or ("number" if name.endswith("_s") else
+                                                        "str" if name.endswith("_reason") else None)
+            if kind:
+                expect(value, kind, where, name, optional=True)
+        if record.get("reach"):
+            for name in (*REACH_FIELDS, *OPTIONAL_REACH_FIELDS):
+                get(record["reach"], name, "number", where, "reach.", optional=name in OPTIONAL_REACH_FIELDS)
         records.append(record)
     return records
 
 
 def read_eval_info(path: Path) -> dict:
-    """A lerobot-eval `eval_info.json`; ValueError naming the file when it is not JSON or lacks what is read."""
+    """A lerobot-eval `eval_info.json`; InputError naming the file when it is not JSON or lacks what is read."""
+    info = read_json(path)
     try:
-        info = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as error:
-        reason = f"{error.msg} at line {error.lineno}" if isinstance(error, json.JSONDecodeError) else "not text"
-        raise InputError(f"{path}: not a JSON file ({reason})") from None
-    try:
-        usable = all("task_group" in task and isinstance(task["task_id"], int)
+        usable = all(isinstance(task["task_group"], str) and isinstance(task["task_id"], int)
                      and isinstance(task["metrics"]["successes"], list) for task in info["per_task"])
     except (KeyError, TypeError):
         usable = False
@@ -364,7 +377,9 @@ def write_report(root: str | Path, workers: int | None = None) -> list[Path]:
 
     root = Path(root)
     report = build_report(root)
+    # The videos first: a damaged one stops the report before any of its files is written.
+    annotated = annotate_videos(eval_dirs(root), usable_cores() if workers is None else workers)
     written = plot(report, root)
     written.append(write_text(root / "results.json", json.dumps(report, indent=2) + "\n"))
     written.append(write_text(root / "results.md", markdown(report)))
-    return written + annotate_videos(eval_dirs(root), usable_cores() if workers is None else workers)
+    return written + annotated

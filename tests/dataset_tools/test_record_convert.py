@@ -15,8 +15,10 @@ from lerobot_tavis.dataset_tools import raw as raw_files
 from lerobot_tavis.dataset_tools import record as recorder
 from lerobot_tavis.dataset_tools.convert import ConvertConfig, ReplayError, convert
 from lerobot_tavis.dataset_tools.features import ACTION_KEY, JOINT_POS_KEY, STATE_KEY, image_key
+from lerobot_tavis.dataset_tools.frames import check_camera_frames, dataset_info, episode_frames
 from lerobot_tavis.envs.robots import make_robot
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
+from lerobot_tavis.errors import InputError
 
 HANDS = suite_tasks("tavis_hands")
 IMAGE_SIZE = (48, 64)
@@ -228,6 +230,23 @@ def test_other_frame_storages_hold_the_same_frames(raw_dir, dataset, tmp_path, s
         np.testing.assert_array_equal(frame[ACTION_KEY].numpy(), expected[ACTION_KEY].numpy())
         # lossless PNG and near-lossless H.264 against AV1 at crf 30: the same picture up to compression noise
         assert np.abs(frame[key].numpy() - expected[key].numpy()).mean() < 0.03
+    check_camera_frames(root, dataset_info(root), episode_frames(root))  # what verify-dataset decodes: every frame
+    if storage == "png":  # an image cut short inside its data file is named with its frame and episode
+        _cut_image(next((root / "data").rglob("*.parquet")), key, row=5)
+        with pytest.raises(InputError, match=f"file-000.parquet: {key} of frame 5 of episode 0 cannot be decoded"):
+            check_camera_frames(root, dataset_info(root), episode_frames(root))
+
+
+def _cut_image(path, key: str, row: int) -> None:
+    """Rewrite the data file `path` with the PNG of image column `key` in `row` cut to its first 100 bytes."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(path)
+    images = table.column(key).to_pylist()
+    images[row] = {**images[row], "bytes": images[row]["bytes"][:100]}
+    field = table.schema.field(key)
+    pq.write_table(table.set_column(table.schema.get_field_index(key), field, pa.array(images, type=field.type)), path)
 
 
 def test_storage_is_checked(raw_dir, tmp_path):

@@ -207,7 +207,7 @@ def _edit_info(root, edit) -> None:
     ("nan rotation", FieldError, "rotation_deg must be a finite number >= 0, got nan"),
     ("negative seed", FieldError, "seed must be an integer >= 0, got -1"),
     ("missing source", PathNotFoundError, "source_root .*missing is not a directory"),
-    ("not a dataset", InputError, "is not a LeRobotDataset: meta/info.json unreadable"),
+    ("not a dataset", PathNotFoundError, r"meta/info.json: missing \(.* is not a LeRobotDataset\)"),
     ("older version", InputError, "is a LeRobotDataset v2.1, not v3.0"),
     ("state of 18", InputError, r"observation.state must be float32 of shape \(19,\)"),
     ("no state", InputError, r"observation.state must be .* got no such feature"),

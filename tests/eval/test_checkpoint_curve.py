@@ -38,7 +38,7 @@ def test_a_folder_without_finished_checkpoints_or_with_a_broken_report_is_refuse
     with pytest.raises(PathNotFoundError, match="no such directory"):
         checkpoint_reports(tmp_path / "missing")
     (tmp_path / "step_800" / "results.json").write_text("{")
-    with pytest.raises(InputError, match="step_800/results.json: not JSON"):
+    with pytest.raises(InputError, match="step_800/results.json: not a JSON file"):
         checkpoint_reports(tmp_path)
     assert not (tmp_path / "checkpoints.md").exists()
 

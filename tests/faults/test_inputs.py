@@ -85,7 +85,7 @@ def test_a_bad_image_size_is_one_line_on_stderr_without_traceback(tmp_path):
 
 
 @pytest.mark.parametrize("content,problem", [
-    ("{not json", "not a JSON file (Expecting property name enclosed in double quotes at line 1)"),
+    ("{not json", "not a JSON file (Expecting property name enclosed in double quotes: line 1, column 2)"),
     ("[1, 2]", "not a lerobot-eval eval_info.json"),
     ('{"overall": {}}', "not a lerobot-eval eval_info.json"),
     ('{"per_task": [{"task_group": "tavis_head", "task_id": 0}]}', "not a lerobot-eval eval_info.json"),
