@@ -25,7 +25,6 @@ def _env(split: str) -> TavisEnv:
 def test_an_episode_looks_the_same_whatever_the_env_played_before(split):
     env = _env(split)
     first = _first_pixels(env, 3)  # a fresh env's first episode
-    assert _first_pixels(env, 3).keys() == first.keys()
     _assert_same(_first_pixels(env, 3), first)  # the same seed again
     other = _first_pixels(env, 4)
     assert any(np.abs(other[c].astype(int) - first[c]).max() > 0 for c in first)  # another seed, another look
