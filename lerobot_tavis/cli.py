@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis.cli_options import CommandParser, from_args, option, spelling
-from lerobot_tavis.errors import FieldError, InputError, TavisError
+from lerobot_tavis.errors import FieldError, InputError, TavisError, surroundings_message
 
 
 @dataclass(frozen=True)
@@ -228,6 +228,10 @@ def main(argv: list[str] | None = None) -> None:
         args.run(from_args(args.options, args))
     except TavisError as error:  # the user's input or surroundings; anything else is a bug, with its traceback
         sys.exit(f"tavis {args.command}: error: {_message(error, args)}")
+    except OSError as error:
+        if (line := surroundings_message(error)) is None:
+            raise
+        sys.exit(f"tavis {args.command}: error: {line}")
 
 
 def _message(error: Exception, args: argparse.Namespace) -> str:
