@@ -14,6 +14,7 @@ from pathlib import Path
 
 from lerobot_tavis.cli_options import CommandParser, from_args, option, spelling
 from lerobot_tavis.errors import FieldError, InputError, TavisError, surroundings_message
+from lerobot_tavis.tempdir import use_private_tempdir
 
 
 @dataclass(frozen=True)
@@ -224,6 +225,7 @@ def main(argv: list[str] | None = None) -> None:
     args = build_parser().parse_args(argv)
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    use_private_tempdir()  # this run's temporary files, and its workers', are removed at exit or by the next run
     try:
         args.run(from_args(args.options, args))
     except TavisError as error:  # the user's input or surroundings; anything else is a bug, with its traceback
@@ -232,6 +234,9 @@ def main(argv: list[str] | None = None) -> None:
         if (line := surroundings_message(error)) is None:
             raise
         sys.exit(f"tavis {args.command}: error: {line}")
+    except KeyboardInterrupt:  # Ctrl-C; the unwinding has removed the staging copies and stopped the workers
+        print(f"tavis {args.command}: interrupted", file=sys.stderr)
+        sys.exit(128 + signal.SIGINT)
 
 
 def _message(error: Exception, args: argparse.Namespace) -> str:

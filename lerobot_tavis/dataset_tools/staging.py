@@ -18,6 +18,7 @@ from pathlib import Path
 
 from lerobot_tavis.atomic import hidden_stem
 from lerobot_tavis.errors import PathExistsError
+from lerobot_tavis.process import alive
 
 _LONGEST_TAG = "partial-4194304-0a1b2c3d"  # "<kind>-<pid>-<id>": Linux pids have at most 7 digits
 
@@ -53,7 +54,7 @@ def clear_leftovers(destination: Path) -> None:
     for leftover in sorted(destination.parent.glob(f".{glob.escape(stem)}.*-*-*")):
         kind, _, owner = leftover.name[len(stem) + 2:].partition("-")
         pid = owner.split("-")[0]
-        if kind not in ("partial", "old") or not pid.isdigit() or _alive(int(pid)):
+        if kind not in ("partial", "old") or not pid.isdigit() or alive(int(pid)):
             continue
         if kind == "old" and not destination.exists():
             os.replace(leftover, destination)
@@ -69,12 +70,3 @@ def _sibling(destination: Path, kind: str) -> Path:
 def _stem(destination: Path) -> str:
     return hidden_stem(destination.name, len(_LONGEST_TAG))
 
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's process
-        return True
-    return True

@@ -19,7 +19,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 
 from lerobot_tavis import checks
 from lerobot_tavis.errors import TavisError
-from lerobot_tavis.process import MAX_NICENESS, die_with_parent
+from lerobot_tavis.process import MAX_NICENESS, die_with_parent, leave_interrupt_to_parent
 
 BACKENDS = ("local", "ray")
 
@@ -109,5 +109,6 @@ def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0, ni
 
 def _start_local_worker(parent_pid: int, niceness: int) -> None:
     die_with_parent(parent_pid)
+    leave_interrupt_to_parent()
     if niceness:
         os.nice(niceness)
