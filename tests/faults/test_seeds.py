@@ -33,7 +33,8 @@ def test_whole_seeds_of_any_integer_type_play_the_same_episode(env):
 
 
 @pytest.mark.parametrize("argv,line", [
-    (["view", "--task", "conditional_pick", "--seed", "-3"], "tavis view: error: --seed must be an integer >= 0, got -3"),
+    (["view", "--task", "conditional_pick", "--seed", "-3"],
+     "tavis view: error: --seed must be an integer >= 0, got -3"),
     (["noise-state", "in", "--out", "out", "--position-m", "0", "--rotation-deg", "0", "--seed", "-2"],
      "tavis noise-state: error: --seed must be an integer >= 0, got -2"),
 ])
