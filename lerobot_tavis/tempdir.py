@@ -36,6 +36,7 @@ def use_private_tempdir() -> Path:
     private = Path(tempfile.mkdtemp(prefix=f"{PREFIX}{os.getpid()}-", dir=current))
     multiprocessing.util.Finalize(None, shutil.rmtree, args=(private,), kwargs={"ignore_errors": True},
                                   exitpriority=_REMOVAL_PRIORITY)
+    os.environ.setdefault("RAY_TMPDIR", str(current))  # a local Ray keeps its sessions (and short socket paths)
     os.environ["TMPDIR"] = str(private)
     tempfile.tempdir = str(private)
     return private

@@ -127,7 +127,7 @@ def test_a_valid_long_name_gets_its_staging_copy_and_a_name_too_long_is_one_line
         (staging / "data").write_text("whole")
     with staged_directory(destination, overwrite=True) as staging:
         staging.mkdir()
-    assert list(tmp_path.iterdir()) == [destination] and list(destination.iterdir()) == []
+    assert set(tmp_path.iterdir()) == {destination, tmpdir_} and list(destination.iterdir()) == []
     assert write_text(tmp_path / ("f" * 250), "x").read_text() == "x"
     too_long = tmp_path / ("d" * (NAME_MAX_BYTES + 1))
     result = _tavis([*EXPERT_EVAL, "--out", str(too_long)], tmpdir=tmpdir_)
@@ -176,20 +176,21 @@ def test_a_killed_evaluation_leaves_its_temporary_files_to_the_next_run(tmp_path
     assert cell["n"] == 4
 
 
-def test_temporary_files_of_workers_and_libraries_go_with_the_run(tmpdir_):
+def test_temporary_files_of_workers_and_libraries_go_with_the_run(tmp_path, tmpdir_):
     """What LeRobot leaves (a config's JSON copy) and multiprocessing's folder, in the run and its workers."""
-    script = ("import multiprocessing, multiprocessing.util, sys, tempfile\n"
-              "from lerobot_tavis.tempdir import use_private_tempdir\n"
-              "def leave():\n"
-              "    tempfile.NamedTemporaryFile('w', suffix='.json', delete=False).close()\n"
-              "    return multiprocessing.util.get_temp_dir()\n"
-              "if __name__ == '__main__':\n"
-              "    use_private_tempdir()\n"
-              "    with multiprocessing.get_context('spawn').Pool(1) as pool:\n"
-              "        print(pool.apply(leave))\n"
-              "    print(leave())\n")
-    result = subprocess.run([sys.executable, "-c", script], env={**os.environ, "TMPDIR": str(tmpdir_)},
-                            capture_output=True, text=True, timeout=120)
+    script = tmp_path / "leave_files.py"
+    script.write_text("import multiprocessing, multiprocessing.util, tempfile\n"
+                      "from lerobot_tavis.tempdir import use_private_tempdir\n"
+                      "def leave():\n"
+                      "    tempfile.NamedTemporaryFile('w', suffix='.json', delete=False).close()\n"
+                      "    return multiprocessing.util.get_temp_dir()\n"
+                      "if __name__ == '__main__':\n"
+                      "    use_private_tempdir()\n"
+                      "    with multiprocessing.get_context('spawn').Pool(1) as pool:\n"
+                      "        print(pool.apply(leave))\n"
+                      "    print(leave())\n")
+    result = subprocess.run([sys.executable, str(script)], env={**os.environ, "TMPDIR": str(tmpdir_)},
+                            capture_output=True, text=True, timeout=300)
     worker_dir, own_dir = result.stdout.split()
     assert all(path.startswith(f"{tmpdir_}/tavis-run-") for path in (worker_dir, own_dir)), result.stderr
     assert list(tmpdir_.iterdir()) == []
