@@ -1,4 +1,5 @@
-"""Worker processes never outlive the process that started them (kill -9 included). No heavy imports."""
+"""Worker processes never outlive the process that started them (kill -9 included) and leave Ctrl-C to it; whether
+a process is alive. No heavy imports."""
 
 from __future__ import annotations
 

@@ -69,4 +69,3 @@ def _sibling(destination: Path, kind: str) -> Path:
 
 def _stem(destination: Path) -> str:
     return hidden_stem(destination.name, len(_LONGEST_TAG))
-
