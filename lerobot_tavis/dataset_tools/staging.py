@@ -30,6 +30,8 @@ def staged_directory(destination: str | Path, *, overwrite: bool = False) -> Ite
     replaced only once the new one is complete."""
     destination = Path(destination).absolute()
     clear_leftovers(destination)
+    if destination.exists() and not destination.is_dir():  # --overwrite replaces a result, never another file
+        raise PathExistsError(f"{destination} is a file, not a directory")
     if destination.exists() and not overwrite:
         raise PathExistsError(f"{destination} already exists (pass --overwrite to replace it)")
     destination.parent.mkdir(parents=True, exist_ok=True)

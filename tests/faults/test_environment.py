@@ -19,6 +19,7 @@ import pytest
 
 from lerobot_tavis.atomic import NAME_MAX_BYTES, write_text
 from lerobot_tavis.dataset_tools.staging import staged_directory
+from lerobot_tavis.errors import PathExistsError
 from lerobot_tavis.eval.report import build_report
 from tests.eval.test_report import _eval_dir
 
@@ -116,7 +117,10 @@ def test_an_output_path_that_is_a_file_is_one_line(tmp_path, tmpdir_):
     result = _tavis(["record", "--tasks", "conditional_pick", "--out", str(a_file / "raw")], tmpdir=tmpdir_)
     assert _one_line(result) == (f"tavis record: error: {a_file} is a file, not a directory (needed for "
                                  f"{a_file / 'raw'})")
-    assert a_file.read_text() == "not a folder"
+    with pytest.raises(PathExistsError, match=f"^{a_file} is a file, not a directory$"):
+        with staged_directory(a_file, overwrite=True):  # what `tavis convert --root FILE --overwrite` stages
+            pass
+    assert a_file.read_text() == "not a folder" and set(tmp_path.iterdir()) == {a_file, tmpdir_}
 
 
 def test_a_valid_long_name_gets_its_staging_copy_and_a_name_too_long_is_one_line(tmp_path, tmpdir_):
