@@ -4,10 +4,28 @@ the partial file. (Whole directories are staged by `dataset_tools.staging`.)"""
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+
+NAME_MAX_BYTES = 255  # the longest file name of Linux's file systems (ext4, xfs, btrfs, tmpfs), in bytes
+NAME_HASH_CHARS = 16  # hex digits of a long name's SHA-256 kept in the names of its hidden siblings
+
+
+def hidden_stem(name: str, tag_bytes: int) -> str:
+    """What the hidden sibling `.<stem>.<tag>` of a file or directory called `name` starts with, for tags of at
+    most `tag_bytes` bytes: `name` itself when the sibling's name fits in NAME_MAX_BYTES, else the start of `name`
+    and a hash of all of it, so that a valid long name still gets siblings and two long names sharing a start do
+    not share them."""
+    encoded = os.fsencode(name)
+    room = NAME_MAX_BYTES - len(b"..") - tag_bytes
+    if len(encoded) <= room:
+        return name
+    digest = hashlib.sha256(encoded).hexdigest()[:NAME_HASH_CHARS]
+    start = encoded[:room - len(digest) - 1].decode("utf-8", errors="ignore")  # never half a character
+    return f"{start}~{digest}"
 
 
 @contextmanager
@@ -16,7 +34,8 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     writers that infer the format from it, e.g. ".png"); moves it onto `path` when the block ends without error."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f".{path.name}.partial{suffix}")
+    tag = f"partial{suffix}"
+    partial = path.with_name(f".{hidden_stem(path.name, len(os.fsencode(tag)))}.{tag}")
     try:
         yield partial
         os.replace(partial, path)

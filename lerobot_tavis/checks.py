@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 import re
 
 from lerobot_tavis.errors import FieldError
@@ -68,6 +69,17 @@ def repo_id(value, field: str = "repo_id") -> str:
         raise FieldError(field, f"must be <owner>/<name> on the Hugging Face Hub: one '/', each part letters, "
                                 f"digits, '-', '_' or '.' (not '--' or '..', nor '-' or '.' at either end), "
                                 f"got {value!r}")
+    return value
+
+
+def utf8(field: str, value: str | os.PathLike) -> str | os.PathLike:
+    """`value` if its text is UTF-8. Python hands over command-line bytes of another encoding (a file name written
+    in Latin-1, say) as lone surrogates, which LeRobot's datasets, JSON files and video writers cannot store."""
+    try:
+        os.fspath(value).encode("utf-8")
+    except UnicodeEncodeError:
+        raise FieldError(field, f"must be UTF-8 text, got {os.fsencode(value)!r} (datasets and reports store "
+                                "names as UTF-8: rename it)") from None
     return value
 
 

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis.cli_options import CommandParser, from_args, option, spelling
-from lerobot_tavis.errors import FieldError, InputError, TavisError
+from lerobot_tavis.errors import FieldError, InputError, TavisError, surroundings_message
+from lerobot_tavis.tempdir import use_private_tempdir
 
 
 @dataclass(frozen=True)
@@ -230,18 +231,28 @@ def _exit_on_sigterm(signum, frame) -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = build_parser().parse_args(argv)
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    command, args = "tavis", None
     try:
+        args = build_parser().parse_args(argv)
+        command = f"tavis {args.command}"
+        if threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, _exit_on_sigterm)
+        use_private_tempdir()  # this run's temporary files, and its workers', are removed at exit or by the next run
         args.run(from_args(args.options, args))
     except TavisError as error:  # the user's input or surroundings; anything else is a bug, with its traceback
-        sys.exit(f"tavis {args.command}: error: {_message(error, args)}")
+        sys.exit(f"{command}: error: {_message(error, args)}")
+    except OSError as error:
+        if (line := surroundings_message(error)) is None:
+            raise
+        sys.exit(f"{command}: error: {line}")
+    except KeyboardInterrupt:  # Ctrl-C; the unwinding has removed the staging copies and stopped the workers
+        print(f"{command}: interrupted", file=sys.stderr)
+        sys.exit(128 + signal.SIGINT)
 
 
-def _message(error: Exception, args: argparse.Namespace) -> str:
+def _message(error: Exception, args: argparse.Namespace | None) -> str:
     """The error in one line; a config's error about one of its fields names the option that set it instead."""
-    if isinstance(error, FieldError):
+    if isinstance(error, FieldError) and args is not None:
         return f"{spelling(args.options, error.field)} {error.problem}"
     return str(error)
 

@@ -17,6 +17,7 @@ import typing
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from lerobot_tavis import checks
 from lerobot_tavis.importpath import resolve
 
 KEY = "tavis_cli"  # where `option()` keeps its settings in a field's metadata
@@ -89,12 +90,16 @@ def add_options(parser: argparse.ArgumentParser, cls: type) -> None:
 
 
 def from_args(cls: type, args: argparse.Namespace):
-    """The dataclass `cls` built from the options given in `args` (parsed by a parser `add_options` made)."""
+    """The dataclass `cls` built from the options given in `args` (parsed by a parser `add_options` made); text that
+    is not UTF-8 (a path in another encoding) is refused, naming the field (`checks.utf8`)."""
     values = {}
     for field in command_fields(cls):
         if hasattr(args, field.name):
             value = getattr(args, field.name)
             value = tuple(value) if isinstance(value, list) else value  # argparse collects several as a list
+            for text in value if isinstance(value, tuple) else (value,):
+                if isinstance(text, (str, Path)):
+                    checks.utf8(field.name, text)
             parse = spec(field).parse
             values[field.name] = parse(value) if parse is not None and value is not None else value
     return cls(**values)

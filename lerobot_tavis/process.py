@@ -1,12 +1,16 @@
-"""Worker processes never outlive the process that started them (kill -9 included). No heavy imports."""
+"""Worker processes never outlive the process that started them (kill -9 included) and leave Ctrl-C to it; whether
+a process is alive. No heavy imports."""
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import multiprocessing
 import os
 import signal
 import sys
+import threading
+from collections.abc import Iterator
 
 _PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
 MAX_NICENESS = 19  # Linux's lowest CPU priority; a process's niceness stops there
@@ -23,6 +27,51 @@ def die_with_parent(parent_pid: int) -> None:
 
 
 def bind_worker_to_parent() -> None:
-    """In a multiprocessing worker (not in a main process): die with the parent that started it."""
+    """In a multiprocessing worker (not in a main process): die with the parent that started it, and leave Ctrl-C
+    to it (`leave_interrupt_to_parent`)."""
     if multiprocessing.parent_process() is not None:
         die_with_parent(os.getppid())
+        leave_interrupt_to_parent()
+
+
+def leave_interrupt_to_parent() -> None:
+    """In a worker: Ctrl-C ends this process at once and quietly, instead of raising KeyboardInterrupt, which
+    printed a traceback per worker. The terminal sends SIGINT to every process of its group; the main process,
+    which alone writes files, reports it once and unwinds, removing its staging copies. A worker started with
+    SIGINT blocked (`dataset_tools.workers`, so that a Ctrl-C while it starts up waits) receives it from here on."""
+    signal.signal(signal.SIGINT, _exit_quietly)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+@contextlib.contextmanager
+def interrupt_deferred() -> Iterator[None]:
+    """Within the block, Ctrl-C waits: a process started meanwhile begins with SIGINT blocked (the signal mask is
+    inherited) until it calls `leave_interrupt_to_parent`, and a Ctrl-C that reached this process is handled when
+    the block ends, not half-way through starting a process (its child then read a truncated start-up message)."""
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    in_main_thread = threading.current_thread() is threading.main_thread()  # Python runs handlers there only
+    arrived = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: arrived.append(signum)) if in_main_thread else None
+    try:
+        yield
+    finally:
+        if in_main_thread:
+            signal.signal(signal.SIGINT, previous)
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+        if arrived:
+            signal.raise_signal(signal.SIGINT)
+
+
+def alive(pid: int) -> bool:
+    """Whether process `pid` exists (another user's counts)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _exit_quietly(signum, frame) -> None:
+    os._exit(128 + signum)

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lerobot_tavis import checks
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS
 from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
@@ -147,6 +148,7 @@ class ViewConfig:
     max_frames: int | None = option(None, command_line=False)
 
     def __post_init__(self):
+        checks.integer("seed", self.seed, 0)
         if self.driver is None:
             object.__setattr__(self, "driver", "policy" if self.policy else "demonstrator")
 

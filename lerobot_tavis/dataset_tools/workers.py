@@ -13,13 +13,13 @@ change what is written, and a Ray cluster needs no filesystem shared with the ca
 
 from __future__ import annotations
 
-import multiprocessing
+import multiprocessing.context
 import os
 from concurrent.futures import Future, ProcessPoolExecutor
 
 from lerobot_tavis import checks
 from lerobot_tavis.errors import TavisError
-from lerobot_tavis.process import MAX_NICENESS, die_with_parent
+from lerobot_tavis.process import MAX_NICENESS, die_with_parent, interrupt_deferred, leave_interrupt_to_parent
 
 BACKENDS = ("local", "ray")
 
@@ -103,11 +103,25 @@ def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0, ni
         return RayExecutor(gpus=gpus_per_job)
     if workers == 1:
         return InlineExecutor()
-    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=_start_local_worker, initargs=(os.getpid(), niceness))
+    return ProcessPoolExecutor(workers, mp_context=_SpawnContext(), initializer=_start_local_worker,
+                               initargs=(os.getpid(), niceness))
+
+
+class _SpawnedWorker(multiprocessing.context.SpawnProcess):
+    """A spawned process that starts with Ctrl-C held back: one while it imports waits until it has been told to
+    end quietly on one (`_start_local_worker`), instead of printing a KeyboardInterrupt traceback."""
+
+    def start(self) -> None:
+        with interrupt_deferred():
+            super().start()
+
+
+class _SpawnContext(multiprocessing.context.SpawnContext):
+    Process = _SpawnedWorker
 
 
 def _start_local_worker(parent_pid: int, niceness: int) -> None:
     die_with_parent(parent_pid)
+    leave_interrupt_to_parent()
     if niceness:
         os.nice(niceness)

@@ -291,8 +291,10 @@ class TavisEnv(gym.Env):
 
 
 def scene_seed(seed: int, task: str) -> int:
-    """The generator seed of episode `seed` of `task`."""
-    return int(np.random.SeedSequence([int(seed), zlib.crc32(task.encode())]).generate_state(1)[0])
+    """The generator seed of episode `seed` (an integer >= 0) of `task`; a fractional, negative or boolean seed is
+    refused, never rounded to another episode."""
+    seed = checks.integer("seed", seed, 0)
+    return int(np.random.SeedSequence([seed, zlib.crc32(task.encode())]).generate_state(1)[0])
 
 
 def warm_up_action(rng: np.random.Generator) -> np.ndarray:

@@ -139,6 +139,7 @@ def apply(model: mujoco.MjModel, data: mujoco.MjData, factors: tuple[str, ...], 
         draw |= _light(model, rng, id_look)
     if "distractors" in factors:
         draw["distractors"] = _place_distractors(model, data, rng, has_table, robot_prefix)
+    mujoco.mj_camlight(model, data)  # the renderer reads the key light's world direction from `data`, not `model`
     return VisualDraw(**draw)
 
 
