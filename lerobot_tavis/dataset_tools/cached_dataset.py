@@ -78,10 +78,10 @@ class TrainingFrameCachedDataset(FrameCachedDataset):
 
 
 def switched_on() -> bool:
-    """Whether TAVIS_FRAME_CACHE asks for the frame cache: 1 yes, 0 or unset no, anything else stops the process
-    with one line (a misspelt switch must not train without the cache unnoticed)."""
+    """Whether TAVIS_FRAME_CACHE asks for the frame cache: 1 yes, 0, empty or unset no, anything else stops the
+    process with one line (a misspelt switch must not train without the cache unnoticed)."""
     value = os.environ.get(SWITCH, "0")
-    if value not in ("0", "1"):
+    if value not in ("", "0", "1"):
         sys.exit(f"{SWITCH}={value!r}: set it to 1 (read video frames from the frame cache) or 0 (decode them)")
     return value == "1"
 
