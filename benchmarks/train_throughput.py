@@ -226,7 +226,7 @@ def scale(args) -> None:
                 name = run_name(setting_name, count, cache)
                 if (results_dir / f"{name}.json").exists() and not args.again:
                     continue
-                workers = args.loader_workers or max(1, args.workers // count - 2)
+                workers = max(1, args.workers // count - 2) if args.loader_workers is None else args.loader_workers
                 batch = args.batch or setting.batch
                 extra = [*setting.overrides, f"--dataset.video_backend={args.video_backend}", *args.extra]
                 print(f"scale: {name} ({workers} loader workers per GPU)", flush=True)
@@ -238,7 +238,8 @@ def scale(args) -> None:
                     failed.append(name)
                     continue
                 result |= {"setting": setting_name, "setting_detail": asdict(setting), "gpus": count,
-                           "cache": cache, "batch_per_gpu": batch, "loader_workers_per_gpu": workers, "device": args.device,
+                           "cache": cache, "batch_per_gpu": batch, "loader_workers_per_gpu": workers,
+                           "device": args.device,
                            "steps": args.steps, "video_backend": args.video_backend}
                 (results_dir / f"{name}.json").write_text(json.dumps(result, indent=1) + "\n")
     write_scale_report(args.work, args.budget, args.episodes)
@@ -275,12 +276,13 @@ def write_scale_report(work: Path, budget: int, episodes: int) -> None:
              f"| GPU utilisation % (mean; lowest GPU) | update s/step | data wait s/step | min to {budget:,} samples |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for run in runs:
+        frames = "frame cache" if run["cache"] else f"decoded ({run['video_backend']})"
         wall = run.get("wall_sps")
         base = single.get((run["setting"], run["cache"]))
         use = run.get("gpu_utilisation") or {}
         utilisation = f"{statistics.mean(use.values()):.0f}; {min(use.values()):.0f}" if use else "n/a"
         lines.append(
-            f"| {run['setting']} | {run['gpus']} | {'frame cache' if run['cache'] else run['video_backend']} "
+            f"| {run['setting']} | {run['gpus']} | {frames} "
             f"| {run['batch_per_gpu']} | {f'{wall:,.0f}' if wall else 'n/a'} "
             f"| {f'{wall / base:.2f}' if wall and base else 'n/a'} | {run['sps']:,.0f} | {utilisation} "
             f"| {run['update']:.3f} | {run['data']:.3f} | {f'{budget / wall / 60:.1f}' if wall else 'n/a'} |")

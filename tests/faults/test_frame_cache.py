@@ -46,7 +46,8 @@ def test_lerobot_train_refuses_a_stale_frame_cache_in_one_line(dataset_root, tmp
     assert "Traceback" not in run.stderr and not (tmp_path / "train" / "checkpoints").exists()
 
 
-@pytest.mark.parametrize(("value", "on"), [("1", True), ("0", False), (None, False), ("", False), ("yes", None), ("true", None)])
+@pytest.mark.parametrize(("value", "on"), [("1", True), ("0", False), (None, False), ("", False), ("yes", None),
+                                           ("true", None)])
 def test_the_switch_is_1_or_0_and_anything_else_stops_in_one_line(monkeypatch, value, on):
     """The plugin module asks `switched_on()` in lerobot-train's process (which the stale-cache test runs)."""
     from lerobot_tavis.dataset_tools.cached_dataset import switched_on
