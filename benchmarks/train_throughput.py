@@ -172,7 +172,7 @@ def train(work: Path, root: Path, preset: str, steps: int, batch: int, workers: 
                    "-m", "lerobot.scripts.lerobot_train", *arguments]
     else:
         command = [sys.executable, "-m", "lerobot.scripts.lerobot_train", *arguments]
-    env = {**os.environ, "TAVIS_FRAME_CACHE": "1" if cache else "0", "TQDM_DISABLE": "1", "PYTHONUNBUFFERED": "1"}
+    env = {**os.environ, "TAVIS_FRAME_CACHE": "1" if cache else "0", "PYTHONUNBUFFERED": "1"}
     if gpus and device == "cuda":
         env["CUDA_VISIBLE_DEVICES"] = ",".join(gpus)
     log_path = work / "logs" / f"{name}.log"

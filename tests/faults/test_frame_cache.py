@@ -63,3 +63,28 @@ def test_the_switch_is_1_or_0_and_anything_else_stops_in_one_line(monkeypatch, v
         switched_on()
     assert stop.value.code == (f"TAVIS_FRAME_CACHE={value!r}: set it to 1 (read video frames from the frame "
                                "cache) or 0 (decode them)")
+
+
+def test_cache_frames_refuses_what_it_cannot_cache_in_one_line_and_writes_nothing(tmp_path):
+    """No dataset there, zero workers, a dataset without videos (frames stored as PNG images)."""
+    missing = tmp_path / "missing"
+    for argv, message in (
+        (["cache-frames", str(missing)], f"tavis cache-frames: error: {missing} is not a LeRobotDataset "
+                                         "(no meta/info.json)"),
+        (["cache-frames", str(missing), "--workers", "0"],
+         "tavis cache-frames: error: --workers must be an integer >= 1, got 0"),
+    ):
+        with pytest.raises(SystemExit) as refusal:
+            main(argv)
+        assert refusal.value.code == message
+    assert not cache_dir(missing).exists()
+
+
+def test_cache_frames_refuses_a_dataset_without_videos(raw_dir, tmp_path):
+    root = convert(ConvertConfig(raw_dir, "local/png", tmp_path / "dataset", image_size=(48, 64), cameras=("head",),
+                                 storage="png", task="conditional_pick"), progress=False)
+    with pytest.raises(SystemExit) as refusal:
+        main(["cache-frames", str(root)])
+    assert refusal.value.code == (f"tavis cache-frames: error: {root.absolute()}: the dataset stores no video "
+                                  "cameras; there is nothing to cache")
+    assert not cache_dir(root).exists()
