@@ -24,9 +24,9 @@
 # hand_relative: the `act_hand_relative_<CONDITION>_compact` preset, ACT whose chunks hold the arm poses in the frame
 # of the hand as measured when the chunk is planned, observation.state read as that anchor alone, with the time
 # since the episode began as an input; its own budget unless set: STEPS 3200, SAVE_FREQ 800, BATCH 128),
-# GPUS (1; N > 1: `train` runs lerobot-train data-parallel in N processes of `accelerate launch`, one per visible GPU,
-# each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS and SAVE_FREQ by N
-# for the one-GPU budget), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
+# GPUS (1; N > 1, not with `pair`: `train` runs lerobot-train data-parallel in N processes of `accelerate launch`,
+# one per visible GPU, each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS
+# and SAVE_FREQ by N for the one-GPU budget), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
 # and reads the frames from it, TAVIS_FRAME_CACHE=1; docs/training.md, "Training at scale"),
 # WORK (/tmp/tavis_baseline).
 #
@@ -214,6 +214,10 @@ evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the id s
 
 case "${1:-}" in
   pair)
+    if (( GPUS > 1 )); then
+      echo "pair gives each condition one GPU of its own; GPUS=$GPUS applies to train, cell and overfit" >&2
+      exit 2
+    fi
     record
     if [ -n "${CUDA_VISIBLE_DEVICES:-}" ]; then IFS=, read -ra gpus <<< "$CUDA_VISIBLE_DEVICES"
     else mapfile -t gpus < <(nvidia-smi --query-gpu=index --format=csv,noheader 2>/dev/null || true); fi

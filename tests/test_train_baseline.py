@@ -229,8 +229,9 @@ def test_gpus_train_data_parallel_through_accelerate_and_frame_cache_reads_a_cac
     ({"GPUS": "0"}, "GPUS must be a number of GPUs >= 1, got '0'"),
     ({"GPUS": "two"}, "GPUS must be a number of GPUs >= 1, got 'two'"),
     ({"FRAME_CACHE": "1"}, "FRAME_CACHE must be on or off, got '1'"),
+    ({"GPUS": "2", "MODE": "pair"}, "pair gives each condition one GPU of its own; GPUS=2 applies to train, cell"),
 ])
 def test_bad_gpus_or_frame_cache_are_refused_before_anything_runs(tmp_path, settings, message):
-    refused = _stubbed(tmp_path, "train", **settings)
+    refused = _stubbed(tmp_path, settings.pop("MODE", "train"), **settings)
     assert refused.returncode == 2 and message in refused.stderr
     assert not (tmp_path / "calls.log").exists()
