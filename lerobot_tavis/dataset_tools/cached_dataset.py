@@ -48,8 +48,9 @@ class CachedFrameReader(DatasetReader):
 
 
 class FrameCachedDataset(LeRobotDataset):
-    """A LeRobotDataset (same arguments) reading its video frames from the frame cache beside its root; refuses a
-    missing or stale cache (StaleFrameCacheError)."""
+    """A LeRobotDataset (same arguments) reading its video frames from the frame cache beside its root, as float32
+    in [0, 1] whatever `return_uint8` asks (module docstring); refuses a missing or stale cache
+    (StaleFrameCacheError)."""
 
     def __init__(self, repo_id: str, root=None, **dataset_arguments):
         super().__init__(repo_id, root=root, **dataset_arguments)
