@@ -85,7 +85,9 @@ def make_data(work: Path, episodes: int, workers: int, storages: list[str], came
                         str(episodes), "--workers", str(workers), "--out", str(work / "raw")], check=True)
     converts = [subprocess.Popen([*tavis_command(), "convert", str(work / "raw"), "--repo-id", f"local/tp-{storage}",
                                   "--root", str(dataset_root(work, storage, image_size)), "--image-size", image_size,
-                                  "--cameras", cameras, "--storage", storage, "--overwrite"])
+                                  "--cameras", cameras, "--storage", storage,
+                                  "--workers", str(max(1, workers // len(storages))),
+                                  "--overwrite"])
                 for storage in storages]
     if any(process.wait() for process in converts):
         raise SystemExit("a conversion failed")
@@ -117,7 +119,7 @@ class GpuUtilisation:
         if not self.gpus:
             return self
         command = ["nvidia-smi", f"--id={','.join(self.gpus)}", "--query-gpu=index,utilization.gpu",
-                   "--format=csv,noheader,nounits", f"-lms={UTILISATION_PERIOD_MS}"]
+                   "--format=csv,noheader,nounits", f"--loop-ms={UTILISATION_PERIOD_MS}"]
         try:
             self._process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         except FileNotFoundError:
