@@ -79,6 +79,8 @@ def dataset_fingerprint(root: str | Path) -> dict[str, str]:
 def write_frame_cache(cfg: CacheFramesConfig) -> list[str]:
     """Decode every video frame of the dataset at `cfg.root` into its cache (an up-to-date cache is kept as it is);
     returns the lines `tavis cache-frames` prints."""
+    from concurrent.futures import as_completed
+
     from tqdm import tqdm
 
     from lerobot_tavis.dataset_tools.staging import staged_directory
@@ -107,7 +109,8 @@ def write_frame_cache(cfg: CacheFramesConfig) -> list[str]:
         with executor(min(cfg.workers, len(jobs))) as pool:
             futures = {pool.submit(decode_episode, *_decode_arguments(meta, rows, episode, key),
                                    cfg.video_backend): (episode, key) for episode, key in jobs}
-            for future in tqdm(futures, desc=f"cache-frames {root.name}", unit="video", disable=len(jobs) < 2):
+            for future in tqdm(as_completed(futures), total=len(jobs), desc=f"cache-frames {root.name}",
+                               unit="video", disable=len(jobs) < 2):  # written as they come: memory stays bounded
                 episode, key = futures[future]
                 start, end = _episode_rows(meta, episode)
                 arrays[key][start:end] = future.result()
