@@ -24,6 +24,10 @@
 # hand_relative: the `act_hand_relative_<CONDITION>_compact` preset, ACT whose chunks hold the arm poses in the frame
 # of the hand as measured when the chunk is planned, observation.state read as that anchor alone, with the time
 # since the episode began as an input; its own budget unless set: STEPS 3200, SAVE_FREQ 800, BATCH 128),
+# GPUS (1; N > 1, not with `pair`: `train` runs lerobot-train data-parallel in N processes of `accelerate launch`,
+# one per visible GPU, each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS
+# and SAVE_FREQ by N for the one-GPU budget), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
+# and reads the frames from it, TAVIS_FRAME_CACHE=1; docs/training.md, "Training at scale"),
 # WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
@@ -66,6 +70,8 @@ CHECKPOINTS=${CHECKPOINTS:-all}
 ACTIONS=${ACTIONS:-absolute}
 if [ "$ACTIONS" = hand_relative ]; then STATE_INPUT=${STATE_INPUT:-off}; else STATE_INPUT=${STATE_INPUT:-on}; fi
 STATE_NOISE=${STATE_NOISE:-}
+GPUS=${GPUS:-1}
+FRAME_CACHE=${FRAME_CACHE:-off}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 read -ra train_options <<< "${TRAIN_OPTIONS:-}"
 WORK=${WORK:-/tmp/tavis_baseline}
@@ -101,6 +107,13 @@ if [ -n "$STATE_NOISE" ] && [ "$STATE_INPUT" = off ]; then
   echo "STATE_NOISE needs STATE_INPUT=on: with STATE_INPUT=off the policy sees no observation.state to noise" >&2
   exit 2
 fi
+case "$GPUS" in
+  ''|*[!0-9]*|0) echo "GPUS must be a number of GPUs >= 1, got '$GPUS'" >&2; exit 2 ;;
+esac
+case "$FRAME_CACHE" in
+  on|off) ;;
+  *) echo "FRAME_CACHE must be on or off, got '$FRAME_CACHE'" >&2; exit 2 ;;
+esac
 SIZE=120x160
 HERE=$(cd "$(dirname "$0")" && pwd)
 
@@ -168,9 +181,20 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]: fails wi
   local dataset=$1 out=$2 status=0 config
   shift 2
   config=$(preset)
-  lerobot-train --config_path="$config" \
+  local launch=(lerobot-train)
+  if (( GPUS > 1 )); then  # LeRobot's data-parallel path; precision stays lerobot-train's (docs/training.md)
+    launch=(accelerate launch --multi_gpu --num_processes "$GPUS" --num_machines 1 --mixed_precision no
+      --dynamo_backend no -m lerobot.scripts.lerobot_train)
+  fi
+  export TAVIS_FRAME_CACHE=0
+  if [ "$FRAME_CACHE" = on ]; then  # written once per dataset; later calls find it up to date
+    tavis cache-frames "$dataset" --workers "$WORKERS" --video-backend "$BACKEND"
+    TAVIS_FRAME_CACHE=1
+  fi
+  "${launch[@]}" --config_path="$config" \
     --dataset.repo_id="local/$(basename "$dataset")" --dataset.root="$dataset" --dataset.video_backend="$BACKEND" \
-    --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true --num_workers="$WORKERS" \
+    --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true \
+    --num_workers=$(( WORKERS / GPUS > 1 ? WORKERS / GPUS : 1 )) \
     --seed="$SEED" --log_freq=100 --output_dir="$out" "${train_options[@]}" "$@" 2>&1 \
     | python3 -c "$PASS_UNTIL_NAN_LOSS" "--output_dir=$out( |$)" || status=$?
   if (( status == 3 )); then
@@ -190,6 +214,10 @@ evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the id s
 
 case "${1:-}" in
   pair)
+    if (( GPUS > 1 )); then
+      echo "pair gives each condition one GPU of its own; GPUS=$GPUS applies to train, cell and overfit" >&2
+      exit 2
+    fi
     record
     if [ -n "${CUDA_VISIBLE_DEVICES:-}" ]; then IFS=, read -ra gpus <<< "$CUDA_VISIBLE_DEVICES"
     else mapfile -t gpus < <(nvidia-smi --query-gpu=index --format=csv,noheader 2>/dev/null || true); fi

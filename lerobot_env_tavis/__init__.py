@@ -1,7 +1,9 @@
 """The plugin module LeRobot imports in every CLI: registers `--env.type=tavis` (it loads LeRobot itself), and
 `--policy.type=act_hand_relative` where LeRobot's policies are loaded already, as lerobot-train and lerobot-eval load
 them before their plugins; the robot and teleop CLIs stay without them. Elsewhere
-`lerobot_tavis.policies.register_policy_types()` registers the policy type."""
+`lerobot_tavis.policies.register_policy_types()` registers the policy type. With `TAVIS_FRAME_CACHE=1`,
+lerobot-train (which has loaded LeRobot's dataset factory by then) reads video frames from the frame cache
+(`lerobot_tavis.dataset_tools.cached_dataset`)."""
 
 import sys
 
@@ -11,5 +13,11 @@ if "lerobot.policies" in sys.modules:
     from lerobot_tavis.policies import register_policy_types
 
     register_policy_types()
+
+if "lerobot.datasets.factory" in sys.modules:
+    from lerobot_tavis.dataset_tools.cached_dataset import switched_on, use_frame_cache
+
+    if switched_on():
+        use_frame_cache()
 
 __all__ = ["TavisEnvConfig"]

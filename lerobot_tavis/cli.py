@@ -205,6 +205,9 @@ def build_parser() -> argparse.ArgumentParser:
         ("view", "lerobot_tavis.viewer:ViewConfig", _view, "MuJoCo's interactive viewer on one episode (a window)"),
         ("convert", "lerobot_tavis.dataset_tools.convert:ConvertConfig", _convert,
          "raw episodes (or an original TAVIS dataset) -> LeRobotDataset v3.0"),
+        ("cache-frames", "lerobot_tavis.dataset_tools.frame_cache:CacheFramesConfig",
+         _printing("lerobot_tavis.dataset_tools.frame_cache:write_frame_cache"),
+         "decode a dataset's video frames once into a cache beside it, for lerobot-train with TAVIS_FRAME_CACHE=1"),
         ("verify-dataset", VerifyOptions, _verify_dataset,
          "replay a converted dataset's actions open loop and check they reproduce its recorded states (exit 1 if "
          "not)"),

@@ -4,6 +4,7 @@ Registering the env type needs `lerobot.envs.configs` (which LeRobot's CLIs load
 the plugin must not load the simulator, the demonstrators or any policy, dataset or video code.
 """
 
+import os
 import subprocess
 import sys
 
@@ -31,6 +32,18 @@ def test_where_lerobot_policies_are_loaded_the_plugin_registers_the_policy_type_
                             "PreTrainedConfig; assert PreTrainedConfig.get_choice_class('act_hand_relative')"
                             ".__name__ == 'ACTHandRelativeConfig'")
     assert "lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative" in loaded
+
+
+def test_where_lerobots_dataset_factory_is_loaded_the_switch_points_it_at_the_frame_cache():
+    """lerobot-train loads the factory before its plugins; TAVIS_FRAME_CACHE=1 swaps its dataset class, else not."""
+    code = ("import lerobot.datasets.factory as factory, lerobot_env_tavis; "
+            "print(factory.LeRobotDataset.__module__, factory.LeRobotDataset.__name__)")
+    for switch, expected in (("1", "lerobot_tavis.dataset_tools.cached_dataset TrainingFrameCachedDataset"),
+                             ("0", "lerobot.datasets.lerobot_dataset LeRobotDataset")):
+        out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True,
+                             env={**os.environ, "TAVIS_FRAME_CACHE": switch}).stdout
+        assert out.split("\n")[-2] == expected
+    assert not [m for m in _modules_after("import lerobot_env_tavis") if m.startswith("lerobot_tavis.dataset_tools")]
 
 
 def test_task_catalog_and_camera_modes_need_no_mujoco():

@@ -28,11 +28,16 @@ for step in 001500 003000; do mkdir -p "$out/checkpoints/$step"; ln -sfn $step "
 """
 
 
+# `accelerate launch ... -m lerobot.scripts.lerobot_train ...` stands in for lerobot-train and logs the cache switch.
+ACCELERATE = ('echo "accelerate $* | cache=${TAVIS_FRAME_CACHE:-}" >> "$CALLS"\n'
+              + LEROBOT_TRAIN.removeprefix(LOG_CALL))
+
+
 def _stubbed(tmp_path, mode, **settings) -> subprocess.CompletedProcess:
     """The script run in `mode` with the stand-ins first on PATH; their calls go to tmp_path / "calls.log"."""
     stubs = tmp_path / "bin"
     stubs.mkdir(parents=True)
-    for name, body in (("tavis", TAVIS), ("lerobot-train", LEROBOT_TRAIN)):
+    for name, body in (("tavis", TAVIS), ("lerobot-train", LEROBOT_TRAIN), ("accelerate", ACCELERATE)):
         (stubs / name).write_text("#!/usr/bin/env bash\n" + body)
         (stubs / name).chmod(0o755)
     env = {**os.environ, "PATH": f"{stubs}:{os.environ['PATH']}", "CALLS": str(tmp_path / "calls.log"),
@@ -203,3 +208,30 @@ touch "$FINISHED"
     assert "step:200 smpl:13K loss:0.9" in run.stdout  # the log passes through up to the NaN
     assert "the training loss became NaN; training stopped" in run.stderr
     assert not (tmp_path / "finished").exists()
+
+
+def test_gpus_train_data_parallel_through_accelerate_and_frame_cache_reads_a_cache_written_once(tmp_path):
+    calls = _run(tmp_path, "train", GPUS="2", FRAME_CACHE="on")
+    dataset = tmp_path / "work" / "dataset_head_wrist"
+    (cache,) = [call.split(" | ")[0] for call in calls if call.startswith("tavis cache-frames")]
+    assert re.fullmatch(rf"tavis cache-frames {dataset} --workers 4 --video-backend (pyav|torchcodec)", cache)
+    (train,) = [call for call in calls if call.startswith("accelerate")]
+    assert train.startswith("accelerate launch --multi_gpu --num_processes 2 --num_machines 1 --mixed_precision no "
+                            "--dynamo_backend no -m lerobot.scripts.lerobot_train --config_path=")
+    assert "--num_workers=2 " in train and train.endswith(" | cache=1")  # WORKERS shared by the two processes
+    assert calls.index(next(call for call in calls if call.startswith("tavis cache-frames"))) < calls.index(train)
+    assert not any(call.startswith("lerobot-train") for call in calls)
+    (single,) = [call for call in _run(tmp_path / "one", "train") if call.startswith("lerobot-train")]
+    assert "--num_workers=4 " in single
+
+
+@pytest.mark.parametrize(("settings", "message"), [
+    ({"GPUS": "0"}, "GPUS must be a number of GPUs >= 1, got '0'"),
+    ({"GPUS": "two"}, "GPUS must be a number of GPUs >= 1, got 'two'"),
+    ({"FRAME_CACHE": "1"}, "FRAME_CACHE must be on or off, got '1'"),
+    ({"GPUS": "2", "MODE": "pair"}, "pair gives each condition one GPU of its own; GPUS=2 applies to train, cell"),
+])
+def test_bad_gpus_or_frame_cache_are_refused_before_anything_runs(tmp_path, settings, message):
+    refused = _stubbed(tmp_path, settings.pop("MODE", "train"), **settings)
+    assert refused.returncode == 2 and message in refused.stderr
+    assert not (tmp_path / "calls.log").exists()

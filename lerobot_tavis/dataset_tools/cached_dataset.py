@@ -1,0 +1,97 @@
+"""LeRobot's dataset with its video frames read from the frame cache (`frame_cache`), and the switch that makes
+lerobot-train use it: `TAVIS_FRAME_CACHE=1` in lerobot-train's environment (docs/training.md).
+
+Only the frame lookup changes. LeRobot's reader still chooses each sample's rows, delta timestamps, padding flags,
+other features and image transforms; where it would decode a camera's frames at a list of timestamps, this reader
+takes the cache's rows at those timestamps (the nearest within `tolerance_s`, as LeRobot's decoders choose).
+
+The frames come back as float32 in [0, 1], the values LeRobot's decoders return unless asked for uint8 (`x / 255`
+of the same uint8 frame). lerobot-train asks its datasets for uint8 frames and converts every camera's batch to
+float in its main process, between two updates; LeRobot 0.6's loop converts uint8 camera frames on the CPU before
+its preprocessor, whose device step casts floating-point tensors only, so the conversion cannot move to the GPU
+without changing LeRobot's loop. Float frames from the loader workers leave the main process only the copy to the
+GPU, from memory the DataLoader has pinned.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+
+import torch
+from lerobot.datasets.dataset_reader import DatasetReader
+from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+from lerobot_tavis.dataset_tools.frame_cache import FrameCache, StaleFrameCacheError
+
+SWITCH = "TAVIS_FRAME_CACHE"
+
+
+class CachedFrameReader(DatasetReader):
+    """LeRobot's DatasetReader whose video frames come from a FrameCache."""
+
+    def __init__(self, frame_cache: FrameCache, **reader_arguments):
+        super().__init__(**reader_arguments)
+        self.frame_cache = frame_cache
+
+    def _query_videos(self, query_timestamps: dict[str, list[float]], ep_idx: int) -> dict[str, torch.Tensor]:
+        """Per camera key, the frames at the timestamps (s, within episode `ep_idx`): (channels, height, width) for
+        one timestamp, (timestamps, channels, height, width) for several, float32 in [0, 1], as LeRobot's."""
+        episode = self._meta.episodes[ep_idx]
+        start, end = int(episode["dataset_from_index"]), int(episode["dataset_to_index"])
+        frames = {}
+        for key, timestamps in query_timestamps.items():
+            rows = self.frame_cache.rows(start, end, timestamps, self._tolerance_s)
+            frames[key] = (torch.from_numpy(self.frame_cache.frames(key, rows)).to(torch.float32) / 255.0).squeeze(0)
+        return frames
+
+
+class FrameCachedDataset(LeRobotDataset):
+    """A LeRobotDataset (same arguments) reading its video frames from the frame cache beside its root, as float32
+    in [0, 1] whatever `return_uint8` asks (module docstring); refuses a missing or stale cache
+    (StaleFrameCacheError)."""
+
+    def __init__(self, repo_id: str, root=None, **dataset_arguments):
+        super().__init__(repo_id, root=root, **dataset_arguments)
+        cache = FrameCache.open(self.root)
+        if cache.video_backend != self._video_backend:
+            logging.warning(f"{cache.directory} was decoded with {cache.video_backend}, this dataset is read with "
+                            f"{self._video_backend}: the frames are {cache.video_backend}'s")
+        reader = CachedFrameReader(cache, meta=self.meta, root=self.root, episodes=self.episodes,
+                                   tolerance_s=self.tolerance_s, video_backend=self._video_backend,
+                                   delta_timestamps=self.delta_timestamps, image_transforms=self.image_transforms,
+                                   return_uint8=self._return_uint8, depth_output_unit=self._depth_output_unit)
+        reader.hf_dataset = self.reader.hf_dataset
+        reader._build_index_mapping()
+        self.reader = reader
+        logging.info(f"{self.root}: video frames from {cache.directory}")
+
+
+class TrainingFrameCachedDataset(FrameCachedDataset):
+    """FrameCachedDataset as lerobot-train's dataset: a missing or stale cache ends the run with one line."""
+
+    def __init__(self, *args, **kwargs):
+        try:
+            super().__init__(*args, **kwargs)
+        except StaleFrameCacheError as error:
+            raise SystemExit(f"lerobot-train: error: {error}") from None
+
+
+def switched_on() -> bool:
+    """Whether TAVIS_FRAME_CACHE asks for the frame cache: 1 yes, 0, empty or unset no, anything else stops the
+    process with one line (a misspelt switch must not train without the cache unnoticed)."""
+    value = os.environ.get(SWITCH, "0")
+    if value not in ("", "0", "1"):
+        sys.exit(f"{SWITCH}={value!r}: set it to 1 (read video frames from the frame cache) or 0 (decode them)")
+    return value == "1"
+
+
+def use_frame_cache() -> None:
+    """Make lerobot-train read video frames from the frame cache: its datasets (training, and the held-out split
+    with `--dataset.eval_split`) are built by `lerobot.datasets.factory`, which this points at
+    TrainingFrameCachedDataset."""
+    import lerobot.datasets.factory as factory
+
+    factory.LeRobotDataset = TrainingFrameCachedDataset
+

@@ -1,0 +1,120 @@
+"""The frame cache (`tavis cache-frames`, `TAVIS_FRAME_CACHE=1`): the samples LeRobot's loader gives, frame by frame
+and timestamp by timestamp, without decoding a video; a cache of an earlier state of the dataset is refused; and
+lerobot-train trains from it, data-parallel under `accelerate launch` (on CPU here: two processes, gloo)."""
+
+import json
+import os
+import pickle
+import shutil
+import subprocess
+import sys
+
+import pytest
+import torch
+
+from lerobot_tavis.cli import main
+from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+from lerobot_tavis.dataset_tools.frame_cache import FrameCache, StaleFrameCacheError, cache_dir
+from lerobot_tavis.dataset_tools.record import RecordConfig, record
+from lerobot_tavis.policy_configs import preset_path
+
+TINY = (48, 64)
+CAMERAS = ("head", "left_wrist", "right_wrist")
+CAMERA_KEYS = [f"observation.images.{camera}" for camera in CAMERAS]
+FPS = 20
+# Two past frames and a chunk of actions: windows that run over both ends of an episode (padding flags, clamped rows).
+DELTA_TIMESTAMPS = {**{key: [-2 / FPS, -1 / FPS, 0.0] for key in [*CAMERA_KEYS, "observation.state"]},
+                    "action": [step / FPS for step in range(6)]}
+
+
+@pytest.fixture(scope="module")
+def dataset_root(tmp_path_factory):
+    """Two conditional_pick demonstrations at 48x64 with the head and wrist cameras (AV1), and their frame cache."""
+    scratch = tmp_path_factory.mktemp("frame_cache")
+    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=2),
+           progress=False)
+    root = convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=TINY, cameras=CAMERAS),
+                   progress=False)
+    main(["cache-frames", str(root)])
+    return root
+
+
+def test_cached_samples_are_lerobots_decoded_samples_without_decoding(dataset_root, monkeypatch):
+    from lerobot.datasets import dataset_reader
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    from lerobot_tavis.dataset_tools.cached_dataset import FrameCachedDataset
+
+    decoded = LeRobotDataset("local/tiny", root=dataset_root, video_backend="pyav", delta_timestamps=DELTA_TIMESTAMPS)
+    expected = [decoded[index] for index in range(len(decoded))]  # frames float32 in [0, 1], LeRobot's decoder
+    assert decoded.num_episodes == 2
+    assert any(sample["observation.images.head_is_pad"].any() for sample in expected)
+
+    def no_decoding(*args, **kwargs):
+        raise AssertionError("the frame cache decoded a video")
+
+    monkeypatch.setattr(dataset_reader, "decode_video_frames", no_decoding)
+    cached = FrameCachedDataset("local/tiny", root=dataset_root, video_backend="pyav",
+                                delta_timestamps=DELTA_TIMESTAMPS, return_uint8=True)  # as lerobot-train asks
+    assert len(cached) == len(expected)
+    cached[0]  # its memory maps are open now; the DataLoader pickles the dataset for its spawned workers, which
+    in_worker = pickle.loads(pickle.dumps(cached))  # open them again
+    for index, want in enumerate(expected):
+        got = (cached if index % 2 else in_worker)[index]
+        assert got.keys() == want.keys()
+        assert got["timestamp"] == want["timestamp"] and got["episode_index"] == want["episode_index"]
+        for key, value in want.items():
+            if isinstance(value, torch.Tensor):
+                assert got[key].dtype == value.dtype and torch.equal(got[key], value), (index, key)
+            else:
+                assert got[key] == value, (index, key)
+
+
+def test_a_cache_of_an_earlier_state_of_the_dataset_is_refused_in_one_line(dataset_root, tmp_path, capsys):
+    copy = shutil.copytree(dataset_root, tmp_path / "dataset")
+    with pytest.raises(StaleFrameCacheError, match="no frame cache for .*; run `tavis cache-frames"):
+        FrameCache.open(copy)
+    shutil.copytree(cache_dir(dataset_root), cache_dir(copy))  # moved with its dataset: still its cache
+    assert FrameCache.open(copy).frame_count == json.loads((cache_dir(copy) / "cache.json").read_text())["frames"]
+    main(["cache-frames", str(copy)])
+    assert "up to date" in capsys.readouterr().out
+
+    video = sorted((copy / "videos").rglob("*.mp4"))[0]
+    with video.open("ab") as file:
+        file.write(b"\0")
+    with pytest.raises(StaleFrameCacheError) as refusal:
+        FrameCache.open(copy)
+    message = str(refusal.value)
+    assert "\n" not in message and "is stale" in message and video.relative_to(copy).as_posix() in message
+    assert f"tavis cache-frames {copy}" in message
+
+    video.write_bytes(video.read_bytes()[:-1])
+    (copy / "meta" / "info.json").write_text((copy / "meta" / "info.json").read_text() + " ")
+    with pytest.raises(StaleFrameCacheError, match="meta/info.json"):
+        FrameCache.open(copy)
+    main(["cache-frames", str(copy)])  # rebuilt for the dataset as it is now
+    assert FrameCache.open(copy).frame_count == FrameCache.open(dataset_root).frame_count
+
+
+def test_lerobot_train_reads_the_cache_data_parallel_under_accelerate(dataset_root, tmp_path):
+    """The hand-frame compact preset (this package's policy type), shrunk for a CPU, in two processes of
+    `accelerate launch` (gloo) reading the cache."""
+    preset = json.loads(preset_path("act_hand_relative_head_wrist_compact").read_text())
+    for feature in preset["policy"]["input_features"].values():
+        feature["shape"] = [3, *TINY]
+    (tmp_path / "preset.json").write_text(json.dumps(preset))
+    env = {**os.environ, "MUJOCO_GL": "egl", "TAVIS_FRAME_CACHE": "1"}
+    train = [sys.executable, "-m", "accelerate.commands.launch", "--multi_gpu", "--num_processes", "2",
+             "--num_machines", "1", "--mixed_precision", "no", "--dynamo_backend", "no",
+             "-m", "lerobot.scripts.lerobot_train", f"--config_path={tmp_path / 'preset.json'}",
+             "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", "--env.task=conditional_pick",
+             "--policy.device=cpu", "--policy.dim_model=32", "--policy.dim_feedforward=64", "--policy.n_heads=2",
+             "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", "--log_freq=1",
+             f"--output_dir={tmp_path / 'train'}"]
+    run = subprocess.run(train, capture_output=True, text=True, env=env, timeout=600)
+    log = run.stdout + run.stderr
+    assert run.returncode == 0, log[-3000:]
+    assert f"video frames from {cache_dir(dataset_root)}" in log
+    assert "Effective batch size: 2 x 2 = 4" in log
+    config = json.loads((tmp_path / "train" / "checkpoints" / "last" / "pretrained_model" / "config.json").read_text())
+    assert config["type"] == "act_hand_relative"
