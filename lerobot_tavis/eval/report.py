@@ -24,7 +24,7 @@ from lerobot_tavis.envs.reach import FAILURE_STAGES, HELD_BACK_M, MOVED_M, REACH
 from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
-from lerobot_tavis.eval.run_identity import RUN_FIELD, differences
+from lerobot_tavis.eval.run_identity import EPISODE_FIELDS, RUN_FIELD, differences
 from lerobot_tavis.metrics.registry import episode_metrics
 from lerobot_tavis.metrics.stats import wilson_interval
 
@@ -199,15 +199,16 @@ def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
 
 
 def _check_same_run(cell: tuple[str, str], first: dict, first_source: Path, record: dict, source: Path) -> None:
-    """InputError naming the cell and the field when `record` was played by another run than the cell's `first`
-    record: another robot or camera mode, or another run identity (`eval.run_identity`; records from before
-    identities were recorded have none, and are compared by robot and camera mode alone)."""
+    """InputError naming the cell and the field when `record` was played otherwise than the cell's `first` record:
+    another robot or camera mode, or a run identity differing in a field that decides how episodes play
+    (`run_identity.EPISODE_FIELDS`: runs of other seeds pool). Records from before run identities have none and
+    are compared by robot and camera mode alone; they do not pool with records that have one."""
     fields = [name for name in ("robot", "camera_mode") if record[name] != first[name]]
     runs = first.get(RUN_FIELD), record.get(RUN_FIELD)
     if not fields and (runs[0] is None) != (runs[1] is None):
         fields = [RUN_FIELD]
     elif not fields and runs[0] is not None:
-        fields = [f"{RUN_FIELD}.{name}" for name in differences(*runs)]
+        fields = [f"{RUN_FIELD}.{name}" for name in differences(*runs, EPISODE_FIELDS)]
     if fields:
         def value(which: dict) -> str:
             return json.dumps(_dotted(which, fields[0]))

@@ -77,11 +77,16 @@ def code_commit() -> str | None:
     return head.stdout.strip() if tracked.returncode == 0 and head.returncode == 0 else None
 
 
-def differences(stored: dict, wanted: dict) -> list[str]:
-    """The compared fields in which two identities differ, in OPTIONS order. The checkpoint's path counts only when
-    either identity lacks its hash."""
+# The fields that decide how an episode of a given seed plays: two runs that differ only in their seeds or episode
+# counts play the same episodes, and a report may pool them.
+EPISODE_FIELDS = tuple(name for name in OPTIONS if name not in ("seed", "episodes"))
+
+
+def differences(stored: dict, wanted: dict, fields: tuple[str, ...] = tuple(OPTIONS)) -> list[str]:
+    """The `fields` in which two identities differ, in OPTIONS order. The checkpoint's path counts only when either
+    identity lacks its hash."""
     hashed = bool(stored.get("policy_sha256") and wanted.get("policy_sha256"))
-    return [name for name in OPTIONS
+    return [name for name in fields
             if stored.get(name) != wanted.get(name) and not (name == "policy" and hashed)]
 
 
@@ -107,4 +112,5 @@ def difference_text(stored: dict, wanted: dict) -> str:
     """The first difference between a stored and a wanted identity, and how many more, in one phrase."""
     names = differences(stored, wanted)
     text = f"{setting_text(names[0], stored)}, not {setting_text(names[0], wanted)}"
-    return text + (f" (and {len(names) - 1} more: {', '.join(names[1:])})" if len(names) > 1 else "")
+    more = [option for option in dict.fromkeys(OPTIONS[name] for name in names[1:]) if option != OPTIONS[names[0]]]
+    return text + (f" (and {', '.join(more)} differ too)" if more else "")
