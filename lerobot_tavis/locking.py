@@ -24,7 +24,8 @@ class OutputInUseError(InputError):
 
 
 def lock_path(directory: str | Path) -> Path:
-    directory = Path(directory).absolute()
+    """`.<name>.lock` beside `directory`, links resolved: two spellings of one directory share its lock."""
+    directory = Path(directory).resolve()
     return directory.with_name(f".{directory.name}.lock")
 
 

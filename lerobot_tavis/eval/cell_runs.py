@@ -81,9 +81,6 @@ def run_cells(cfg, cells: Sequence, identity: dict) -> None:
     play = _play_expert_chunk if cfg.policy_path is None else _play_policy_chunk
     chunks = {cell.name: _chunks(cfg, cell) for cell in cells}
     work = {cell.name: cfg.out_dir / f".{cell.name}.chunks" for cell in cells}
-    for folder in work.values():
-        if not (folder / RUN_FILE).exists():
-            write_text(folder / RUN_FILE, json.dumps(identity, indent=1) + "\n")
     waiting = {name: [c for c in cell_chunks if not _done_path(work[name], c).exists()]
                for name, cell_chunks in chunks.items()}
     todo = [chunk for name in waiting for chunk in waiting[name]]
@@ -238,9 +235,10 @@ def _done_path(work: Path, chunk: Chunk) -> Path:
 
 def _keep_chunk(work: Path, result: ChunkResult, identity: dict) -> None:
     """Write a finished chunk's episode log, each record with the run's `identity`, and videos, then its `done`
-    record (the proof it is complete)."""
+    record (the proof it is complete). The cell's first kept chunk writes the identity into the folder first."""
     chunk = result.chunk
-    work.mkdir(parents=True, exist_ok=True)
+    if not (work / RUN_FILE).exists():
+        write_text(work / RUN_FILE, json.dumps(identity, indent=1) + "\n")
     (work / f"{chunk.stem}.jsonl").write_text("".join(json.dumps(json.loads(line) | {RUN_FIELD: identity}) + "\n"
                                                       for line in result.log_text.splitlines()))
     for name, data in result.videos.items():

@@ -4,7 +4,9 @@ Cells are suite x split (`id`, `ood_spatial`, `ood_init_pose`), 96 episodes per 
 of `--tasks`) by default, seeds from 1000 as lerobot-eval uses them. Policy and demonstrators alike play (cell,
 task, seed chunk) jobs over all workers (`cell_runs`): a policy chunk is one lerobot-eval run in a worker process,
 so several share one GPU; the demonstrators play through the same env and episode log. Finished chunks survive a
-kill and each cell is moved into place when complete, so a re-run skips finished cells and chunks.
+kill and each cell is moved into place when complete, so a re-run skips finished cells and chunks: those played with
+the same settings (`eval.run_identity`); others are refused, naming the difference, or with `--restart` played again.
+One run at a time writes an output directory (`locking`).
 `wall_clock_s.txt` in a cell is the time from the start of the command to the cell's completion. The report
 (`tavis report`) is written at the end.
 """
