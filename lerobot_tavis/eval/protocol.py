@@ -30,7 +30,7 @@ from lerobot_tavis.envs.tasks.catalog import (BENCHMARK_TASKS, PROTOCOL_SPLITS, 
 from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.eval.cell_runs import played_tasks, run_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, read_eval_info, write_report
-from lerobot_tavis.eval.run_identity import RUN_FIELD, RUN_FILE, difference_text, differences, read_json, run_identity
+from lerobot_tavis.eval.run_identity import RUN_FIELD, RUN_FILE, difference_text, differences, read_identity, run_identity
 from lerobot_tavis.locking import exclusive_output
 
 START_SEED = 1000
@@ -236,7 +236,7 @@ def _played_with(folder: Path, identity: dict) -> str | None:
     """How the cell in `folder` (a finished cell, or a `.<cell>.chunks` folder) was played, when its settings differ
     from `identity` or are unknown; None when they are the same."""
     if folder.name.endswith(".chunks"):
-        stored = read_json(folder / RUN_FILE) if (folder / RUN_FILE).exists() else None
+        stored = read_identity(folder / RUN_FILE) if (folder / RUN_FILE).exists() else None
     else:
         stored = read_eval_info(folder / EVAL_INFO_NAME).get(RUN_FIELD)
         if stored is not None and not isinstance(stored, dict):

@@ -205,6 +205,9 @@ def _check_same_run(cell: tuple[str, str], first: dict, first_source: Path, reco
     are compared by robot and camera mode alone; they do not pool with records that have one."""
     fields = [name for name in ("robot", "camera_mode") if record[name] != first[name]]
     runs = first.get(RUN_FIELD), record.get(RUN_FIELD)
+    if not isinstance(runs[1], dict | None):
+        raise InputError(f"{source / EPISODE_LOG_NAME}: a record of {cell[0]} {cell[1]} (seed {record['seed']}) has a "
+                         f"{RUN_FIELD!r} that is not a run identity (a JSON object)")
     if not fields and (runs[0] is None) != (runs[1] is None):
         fields = [RUN_FIELD]
     elif not fields and runs[0] is not None:

@@ -3,9 +3,9 @@
 The identity is a JSON object of the settings that decide a cell's episodes: the policy (a local checkpoint's path
 and the SHA-256 of its files, a Hub repo id by name, or the scripted demonstrators), its `--policy-option` fields,
 robot, camera mode, image size ([H, W] px), episode length (s), first seed, episodes per task and the package
-version. `code_commit`, the git commit of the code when it runs from a git checkout, is recorded but
-not compared: most commits do not change what an evaluation plays. A local checkpoint counts as the same policy
-when its files are, wherever it lies. `tavis eval` keeps the identity in `.<cell>.chunks/run.json` while it plays a
+version. `code_commit`, the git commit of the code when it runs from a git checkout, is recorded but not compared:
+most commits do not change what an evaluation plays. A local checkpoint counts as the same policy when its files
+are, wherever it lies. `tavis eval` keeps the identity in `.<cell>.chunks/run.json` while it plays a
 cell, then in the cell's `eval_info.json` and in every record of its `episodes.jsonl` (both under "run"), so a
 resumed or re-run evaluation with other settings is refused and `tavis report` finds a cell that mixes runs.
 """
@@ -40,11 +40,11 @@ def run_identity(cfg) -> dict:
                 "policy_options": [list(pair) for pair in cfg.policy_options], "robot": cfg.robot,
                 "camera_mode": cfg.camera_mode, "image_size": list(cfg.image_size),
                 "episode_length_s": float(cfg.episode_length_s), "seed": cfg.seed, "episodes": cfg.n_episodes,
-                "code_version": metadata.version("lerobot_env_tavis"), "code_commit": code_commit()}
+                "code_version": code_version(), "code_commit": code_commit()}
     return json.loads(json.dumps(identity))  # as it reads back from a file
 
 
-def read_json(path: Path) -> dict:
+def read_identity(path: Path) -> dict:
     """A stored identity (`run.json`); InputError naming the file when it is not a JSON object."""
     try:
         identity = json.loads(Path(path).read_text())
@@ -62,6 +62,14 @@ def checkpoint_sha256(directory: str | Path) -> str:
     for path in sorted(p for p in directory.rglob("*") if p.is_file()):
         digest.update(f"{path.relative_to(directory).as_posix()}\0{file_sha256(path)}\n".encode())
     return digest.hexdigest()
+
+
+def code_version() -> str | None:
+    """The installed version of the distribution (None when the code runs uninstalled)."""
+    try:
+        return metadata.version("lerobot_env_tavis")
+    except metadata.PackageNotFoundError:
+        return None
 
 
 def code_commit() -> str | None:
