@@ -189,6 +189,7 @@ def test_a_second_run_into_an_output_in_use_is_refused_and_kill_9_leaves_no_stal
         first.wait()
     with exclusive_output(tmp_path / "out"):  # the kernel released the lock of the killed run
         assert f"pid {os.getpid()} " in lock.read_text()
+    assert not lock.exists()  # removed by the run that ends
 
 
 def _files(folder) -> dict:
