@@ -36,6 +36,7 @@ from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import split_names, task_names
 from lerobot_tavis.errors import TavisError
+from lerobot_tavis.locking import exclusive_output
 from lerobot_tavis.viewer import (KEY_BACKSPACE, KEY_DOWN, KEY_ENTER, KEY_LEFT, KEY_RIGHT, KEY_SPACE, KEY_TAB, KEY_UP,
                                   WINDOW_CAMERAS)
 
@@ -171,7 +172,13 @@ def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
            show: Callable[[], None] | None = None, gamepad=None) -> list[str]:
     """Record `cfg.episodes` kept episodes into `cfg.out_dir`; returns each episode's outcome line. Without `keys`
     and `show` it opens the viewer window, and with `cfg.gamepad` LeRobot's gamepad controller (tests pass scripted
-    key presses and controllers instead)."""
+    key presses and controllers instead). Holds the directory's lock (`locking`), as `tavis record` does."""
+    with exclusive_output(cfg.out_dir):
+        return _teleop(cfg, keys, show, gamepad)
+
+
+def _teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None, show: Callable[[], None] | None,
+            gamepad) -> list[str]:
     from lerobot_tavis.dataset_tools.raw import ManifestEntry
     from lerobot_tavis.dataset_tools.record import RECORD_FPS, open_manifest, store_episode
     from lerobot_tavis.envs.env import TavisEnv

@@ -34,7 +34,8 @@ from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
 from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.dataset_tools.workers import executor
 from lerobot_tavis.envs.tasks.catalog import task_sort_key
-from lerobot_tavis.errors import InputError, TavisError
+from lerobot_tavis.errors import FieldError, InputError, TavisError
+from lerobot_tavis.locking import exclusive_output
 
 CONVERSION_LOG = "meta/tavis_conversion.json"
 RAW_IMAGE_SIZE = (480, 640)  # (H, W) of the cameras rendered from raw episodes unless told otherwise
@@ -74,14 +75,31 @@ class ConvertConfig:
         if self.from_tavis is not None and (self.zero_neck or self.storage != "av1"):
             raise InputError("--zero-neck and --storage apply to raw episodes, not to --from-tavis")
         checks.repo_id(self.repo_id)
+        _check_root_apart(self.root, self.raw_dir if self.from_tavis is None else self.from_tavis)
         if self.raw_dir is not None:
             object.__setattr__(self, "image_size", checks.image_size(
                 RAW_IMAGE_SIZE if self.image_size is None else self.image_size))
             checks.integer("workers", self.workers, 1)
 
 
+def _check_root_apart(root: Path, source: Path) -> None:
+    """Refuse a destination that is the source, inside it or above it: replacing it (--overwrite) would delete the
+    episodes being read, and a dataset inside a raw directory mixes the two. Compared after resolving links."""
+    root_at, source_at = Path(root).resolve(), Path(source).resolve()
+    if root_at == source_at or source_at in root_at.parents or root_at in source_at.parents:
+        where = ("is" if root_at == source_at else "is inside" if source_at in root_at.parents else "holds")
+        raise FieldError("root", f"{root} {where} the input {source}: a conversion never writes where it reads; give a "
+                                 "destination outside it")
+
+
 def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
-    """Convert `cfg.raw_dir` (or `cfg.from_tavis`) into a LeRobotDataset at `cfg.root`; returns the root."""
+    """Convert `cfg.raw_dir` (or `cfg.from_tavis`) into a LeRobotDataset at `cfg.root`; returns the root. One
+    conversion at a time per root (`locking`): another one converting into it is refused, naming it."""
+    with exclusive_output(cfg.root):
+        return _convert(cfg, progress)
+
+
+def _convert(cfg: ConvertConfig, progress: bool) -> Path:
     if cfg.from_tavis is not None:
         from lerobot_tavis.dataset_tools.from_tavis import convert_from_tavis
 

@@ -26,6 +26,7 @@ from lerobot_tavis.dataset_tools.workers import BACKENDS, executor
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import SUITES, expand_tasks, split_names
 from lerobot_tavis.errors import FieldError, InputError
+from lerobot_tavis.locking import exclusive_output
 
 RECORD_FPS = 60
 
@@ -62,7 +63,13 @@ class RecordConfig:
 
 
 def record(cfg: RecordConfig, progress: bool = True) -> Manifest:
-    """Record (or finish recording) `cfg.out_dir`; returns its manifest."""
+    """Record (or finish recording) `cfg.out_dir`; returns its manifest. One run at a time per directory
+    (`locking`): another run recording into it is refused, naming it."""
+    with exclusive_output(cfg.out_dir):
+        return _record(cfg, progress)
+
+
+def _record(cfg: RecordConfig, progress: bool) -> Manifest:
     from lerobot_tavis.envs.tasks.catalog import parse_split, task_info
 
     for task in cfg.tasks:

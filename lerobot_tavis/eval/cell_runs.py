@@ -5,8 +5,9 @@ or every share of a GPU, stays busy whatever the number of tasks. A chunk's outc
 split and seeds (a policy chunk is one lerobot-eval run seeded with its first seed), each chunk's results come back
 to this process, and each cell is assembled in a fixed order (task, then seed) once its last chunk is done: the
 results do not depend on the backend, the number of workers or the finishing order. Finished chunks are kept in the
-hidden folder `.<cell>.chunks/` (episode log and a `done` record), so a killed run resumes at chunk granularity;
-`tavis report` never reads hidden folders.
+hidden folder `.<cell>.chunks/` (episode log and a `done` record, and the run's identity in `run.json`,
+`eval.run_identity`), so a killed run resumes at chunk granularity; `tavis report` never reads hidden folders. Every
+episode record and the cell's `eval_info.json` carry the run's identity (`"run"`).
 
 - Demonstrators render nothing: they act on the simulator state, so pixels cannot change an outcome (the camera
   mode still fixes whether the neck moves).
@@ -41,6 +42,7 @@ from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.annotate import ANNOTATED_DIR, Annotator, episode_index
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.report import EVAL_INFO_NAME
+from lerobot_tavis.eval.run_identity import RUN_FIELD, RUN_FILE
 from lerobot_tavis.policies import register_policy_types
 
 METRICS = ("successes", "sum_rewards", "max_rewards")  # per-episode lists of lerobot-eval's per-task metrics
@@ -72,9 +74,10 @@ class ChunkResult:
     videos: dict[str, bytes]  # file name -> mp4, for the first chunk of a task
 
 
-def run_cells(cfg, cells: Sequence) -> None:
+def run_cells(cfg, cells: Sequence, identity: dict) -> None:
     """Play every pending cell's episodes (policy `cfg.policy_path`, else the demonstrators) and write each cell
-    as lerobot-eval would."""
+    as lerobot-eval would, with the run's `identity` (`run_identity.run_identity(cfg)`) in every record. A cell's
+    chunk folder, when there is one, holds chunks of this identity (the caller checks it)."""
     play = _play_expert_chunk if cfg.policy_path is None else _play_policy_chunk
     chunks = {cell.name: _chunks(cfg, cell) for cell in cells}
     work = {cell.name: cfg.out_dir / f".{cell.name}.chunks" for cell in cells}
@@ -87,16 +90,16 @@ def run_cells(cfg, cells: Sequence) -> None:
     with (tqdm(total=total, initial=total - sum(c.n for c in todo), desc=desc, unit="ep") as bar,
           Annotator(usable_cores()) as annotator):
         for name in [name for name, left in waiting.items() if not left]:  # finished before a kill
-            _assemble(cfg, name, chunks[name], work[name], started)
+            _assemble(cfg, name, chunks[name], work[name], started, identity)
         for result in _completed(cfg, play, [(cfg, chunk) for chunk in todo]):
             chunk = result.chunk
-            _keep_chunk(work[chunk.cell_name], result)
+            _keep_chunk(work[chunk.cell_name], result, identity)
             _annotate_chunk(annotator, work[chunk.cell_name], result)
             bar.update(chunk.n)
             waiting[chunk.cell_name].remove(chunk)
             if not waiting[chunk.cell_name]:
                 annotator.write(chunk.cell_name)
-                _assemble(cfg, chunk.cell_name, chunks[chunk.cell_name], work[chunk.cell_name], started)
+                _assemble(cfg, chunk.cell_name, chunks[chunk.cell_name], work[chunk.cell_name], started, identity)
 
 
 def _chunks(cfg, cell) -> list[Chunk]:
@@ -230,11 +233,14 @@ def _done_path(work: Path, chunk: Chunk) -> Path:
     return work / f"{chunk.stem}.done.json"
 
 
-def _keep_chunk(work: Path, result: ChunkResult) -> None:
-    """Write a finished chunk's episode log and videos, then its `done` record (the proof it is complete)."""
+def _keep_chunk(work: Path, result: ChunkResult, identity: dict) -> None:
+    """Write a finished chunk's episode log, each record with the run's `identity`, and videos, then its `done`
+    record (the proof it is complete). The cell's first kept chunk writes the identity into the folder first."""
     chunk = result.chunk
-    work.mkdir(parents=True, exist_ok=True)
-    (work / f"{chunk.stem}.jsonl").write_text(result.log_text)
+    if not (work / RUN_FILE).exists():
+        write_text(work / RUN_FILE, json.dumps(identity, indent=1) + "\n")
+    (work / f"{chunk.stem}.jsonl").write_text("".join(json.dumps(json.loads(line) | {RUN_FIELD: identity}) + "\n"
+                                                      for line in result.log_text.splitlines()))
     for name, data in result.videos.items():
         video = work / f"{chunk.stem}.videos" / name
         video.parent.mkdir(exist_ok=True)
@@ -255,7 +261,7 @@ def _annotate_chunk(annotator: Annotator, work: Path, result: ChunkResult) -> No
             annotator.submit(chunk.cell_name, video, work / f"{chunk.stem}.{ANNOTATED_DIR}" / name, record)
 
 
-def _assemble(cfg, cell_name: str, chunks: list[Chunk], work: Path, started: float) -> None:
+def _assemble(cfg, cell_name: str, chunks: list[Chunk], work: Path, started: float, identity: dict) -> None:
     """Write the cell from its chunks, in task then seed order, and drop the chunks."""
     suite = chunks[0].suite
     per_task: dict[int, dict[str, list]] = {}
@@ -279,7 +285,8 @@ def _assemble(cfg, cell_name: str, chunks: list[Chunk], work: Path, started: flo
         flat = [s for metrics in per_task.values() for s in metrics["successes"]]
         summary = {"pc_success": 100.0 * sum(flat) / len(flat), "n_episodes": len(flat)}
         policy = "scripted demonstrators" if cfg.policy_path is None else str(cfg.policy_path)
-        info = {"per_task": tasks, "per_group": {suite: summary}, "overall": summary, "policy": policy}
+        info = {"per_task": tasks, "per_group": {suite: summary}, "overall": summary, "policy": policy,
+                RUN_FIELD: identity}
         (partial / EVAL_INFO_NAME).write_text(json.dumps(info, indent=2) + "\n")
         (partial / "wall_clock_s.txt").write_text(f"{time.perf_counter() - started:.1f}\n")
     shutil.rmtree(work)

@@ -4,7 +4,9 @@ Cells are suite x split (`id`, `ood_spatial`, `ood_init_pose`), 96 episodes per 
 of `--tasks`) by default, seeds from 1000 as lerobot-eval uses them. Policy and demonstrators alike play (cell,
 task, seed chunk) jobs over all workers (`cell_runs`): a policy chunk is one lerobot-eval run in a worker process,
 so several share one GPU; the demonstrators play through the same env and episode log. Finished chunks survive a
-kill and each cell is moved into place when complete, so a re-run skips finished cells and chunks.
+kill and each cell is moved into place when complete, so a re-run skips finished cells and chunks: those played with
+the same settings (`eval.run_identity`); others are refused, naming the difference, or with `--restart` played again.
+One run at a time writes an output directory (`locking`).
 `wall_clock_s.txt` in a cell is the time from the start of the command to the cell's completion. The report
 (`tavis report`) is written at the end.
 """
@@ -12,6 +14,7 @@ kill and each cell is moved into place when complete, so a re-run skips finished
 from __future__ import annotations
 
 import json
+import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,7 +29,9 @@ from lerobot_tavis.envs.tasks.catalog import (BENCHMARK_TASKS, PROTOCOL_SPLITS, 
                                               task_info)
 from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.eval.cell_runs import played_tasks, run_cells
-from lerobot_tavis.eval.report import EVAL_INFO_NAME, write_report
+from lerobot_tavis.eval.report import EVAL_INFO_NAME, read_eval_info, write_report
+from lerobot_tavis.eval.run_identity import RUN_FIELD, RUN_FILE, difference_text, differences, read_identity, run_identity
+from lerobot_tavis.locking import exclusive_output
 
 START_SEED = 1000
 
@@ -97,7 +102,10 @@ class ProtocolConfig:
     backend: str = option("local", "local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)",
                           choices=BACKENDS)
     seed: int = option(START_SEED, "first episode seed (lerobot-eval's default)")
-    out_dir: Path = option(help="output directory; finished cells are skipped on re-runs", flag="--out")
+    out_dir: Path = option(help="output directory; a re-run with the same settings resumes it, skipping finished "
+                           "cells and chunks", flag="--out")
+    restart: bool = option(False, "play again the cells of --out that were played with other settings (default: "
+                           "refuse them, naming the difference)")
 
     def __post_init__(self):
         if bool(self.policy_path) == self.expert:
@@ -170,25 +178,69 @@ def _trained_env(policy_path: str) -> dict:
 
 
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:
-    cfg.out_dir.mkdir(parents=True, exist_ok=True)
-    cells = [Cell(suite, split) for split in cfg.splits for suite in cfg.suites if played_tasks(cfg, suite)]
-    pending = []
-    for cell in cells:
-        info = cfg.out_dir / cell.name / EVAL_INFO_NAME
-        if not info.exists():
-            pending.append(cell)
-            continue
-        held = [task["task_id"] for task in json.loads(info.read_text())["per_task"]]
-        if held != [task_id for task_id, _ in played_tasks(cfg, cell.suite)]:
-            raise InputError(f"{info.parent} holds the tasks {[suite_tasks(cell.suite)[i] for i in held]}, not those "
-                             "asked for: give another --out")
-        print(f"{cell.name}: done already, skipped")
-    # A bad --policy-option fails in the first job, when it reads the checkpoint's config: checking it here first
-    # would import LeRobot in this process too, which held back the start of every job by 27 s on the one-H100
-    # machine (docs/benchmarks.md).
-    started = time.perf_counter()
-    run_cells(cfg, pending)
-    played = time.perf_counter()
-    written = write_report(cfg.out_dir)
+    """Play the cells of `cfg` not yet in `cfg.out_dir`, then write the report; returns the written files. One run
+    at a time per output directory (`locking`)."""
+    with exclusive_output(cfg.out_dir):
+        cfg.out_dir.mkdir(parents=True, exist_ok=True)
+        identity = run_identity(cfg)
+        cells = [Cell(suite, split) for split in cfg.splits for suite in cfg.suites if played_tasks(cfg, suite)]
+        _check_other_cells(cfg, cells, identity)
+        pending = [cell for cell in cells if not _finished(cfg, cell, identity)]
+        # A bad --policy-option fails in the first job, when it reads the checkpoint's config: checking it here
+        # first would import LeRobot in this process too, which held back the start of every job by 27 s on the
+        # one-H100 machine (docs/benchmarks.md).
+        started = time.perf_counter()
+        run_cells(cfg, pending, identity)
+        played = time.perf_counter()
+        written = write_report(cfg.out_dir)
     print(f"episodes played in {played - started:.1f} s, report written in {time.perf_counter() - played:.1f} s")
     return written
+
+
+def _check_other_cells(cfg: ProtocolConfig, cells: list[Cell], identity: dict) -> None:
+    """Refuse an output directory holding cells (finished or begun) that this run does not play, of a run with
+    other settings: one output directory holds the cells of one run, so its report compares like with like."""
+    played = {name for cell in cells for name in (cell.name, f".{cell.name}.chunks")}
+    held = [info.parent for info in cfg.out_dir.glob(f"*/{EVAL_INFO_NAME}")] + list(cfg.out_dir.glob(".*.chunks"))
+    for folder in sorted(held):
+        if folder.name not in played and (problem := _played_with(folder, identity)):
+            raise InputError(f"{cfg.out_dir} holds {folder.name}, which {problem}: one output directory holds the "
+                             "cells of one run; give another --out")
+
+
+def _finished(cfg: ProtocolConfig, cell: Cell, identity: dict) -> bool:
+    """Whether `cell` is in `cfg.out_dir` already, played with these settings. A finished or begun copy of the cell
+    from a run with other settings (or from before runs recorded them) is refused, naming the difference; with
+    `cfg.restart` it is removed, to be played again."""
+    folder, chunks = cfg.out_dir / cell.name, cfg.out_dir / f".{cell.name}.chunks"
+    for held, exists in ((folder, (folder / EVAL_INFO_NAME).exists()), (chunks, chunks.exists())):
+        if not exists or not (problem := _played_with(held, identity)):
+            continue
+        if not cfg.restart:
+            raise InputError(f"{held} {problem}: pass --restart to play it again with these settings, or give "
+                             "another --out")
+        print(f"{cell.name}: played with other settings, playing it again (--restart)")
+        shutil.rmtree(held)
+    if not (folder / EVAL_INFO_NAME).exists():
+        return False
+    held = [task["task_id"] for task in read_eval_info(folder / EVAL_INFO_NAME)["per_task"]]
+    if held != [task_id for task_id, _ in played_tasks(cfg, cell.suite)]:
+        raise InputError(f"{folder} holds the tasks {[suite_tasks(cell.suite)[i] for i in held]}, not those "
+                         "asked for: give another --out")
+    shutil.rmtree(chunks, ignore_errors=True)  # left by a run killed between writing the cell and removing them
+    print(f"{cell.name}: done already, skipped")
+    return True
+
+
+def _played_with(folder: Path, identity: dict) -> str | None:
+    """How the cell in `folder` (a finished cell, or a `.<cell>.chunks` folder) was played, when its settings differ
+    from `identity` or are unknown; None when they are the same."""
+    if folder.name.endswith(".chunks"):
+        stored = read_identity(folder / RUN_FILE) if (folder / RUN_FILE).exists() else None
+    else:
+        stored = read_eval_info(folder / EVAL_INFO_NAME).get(RUN_FIELD)
+        if stored is not None and not isinstance(stored, dict):
+            raise InputError(f"{folder / EVAL_INFO_NAME}: its {RUN_FIELD!r} is not a run identity (a JSON object)")
+    if stored is None:
+        return "predates run identities (its settings are unknown; `tavis report` still reads it)"
+    return f"was played with {difference_text(stored, identity)}" if differences(stored, identity) else None

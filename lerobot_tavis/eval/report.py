@@ -24,6 +24,7 @@ from lerobot_tavis.envs.reach import FAILURE_STAGES, HELD_BACK_M, MOVED_M, REACH
 from lerobot_tavis.envs.tasks.catalog import SPLITS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
+from lerobot_tavis.eval.run_identity import EPISODE_FIELDS, RUN_FIELD, differences
 from lerobot_tavis.metrics.registry import episode_metrics
 from lerobot_tavis.metrics.stats import wilson_interval
 from lerobot_tavis.readers import expect, get, read_json, read_json_lines
@@ -177,7 +178,8 @@ def join(eval_dir: Path) -> tuple[list[dict], dict]:
             record = {**latest[ix], "episode_ix": ix}
             mismatches += bool(record["success"]) != bool(success)
             episodes.append(record)
-    return episodes, {"source": str(eval_dir), "success_mismatches": mismatches}
+    run = {RUN_FIELD: info[RUN_FIELD]} if RUN_FIELD in info else {}  # absent from results before run identities
+    return episodes, {"source": str(eval_dir), "success_mismatches": mismatches, **run}
 
 
 def eval_dirs(root: Path) -> list[Path]:
@@ -192,19 +194,51 @@ def eval_dirs(root: Path) -> list[Path]:
 
 def collect(root: Path) -> tuple[dict[tuple[str, str], Cell], list[dict]]:
     cells: dict[tuple[str, str], Cell] = {}
+    firsts: dict[tuple[str, str], tuple[dict, Path]] = {}  # per cell: its first record and that record's source
     sources = []
     for eval_dir in eval_dirs(root):
         episodes, meta = join(eval_dir)
         sources.append(meta)
         for record in episodes:
-            cell = cells.setdefault((record["task"], record["split"]),
-                                    Cell(record["task"], record["suite"], record["split"]))
+            key = (record["task"], record["split"])
+            cell = cells.setdefault(key, Cell(record["task"], record["suite"], record["split"]))
+            _check_same_run(key, *firsts.setdefault(key, (record, eval_dir)), record, eval_dir)
             cell.add(record)
             meta.setdefault("robots", set()).add(record["robot"])
             meta.setdefault("camera_modes", set()).add(record["camera_mode"])
     for meta in sources:
         meta["robots"], meta["camera_modes"] = sorted(meta.get("robots", ())), sorted(meta.get("camera_modes", ()))
     return cells, sources
+
+
+def _check_same_run(cell: tuple[str, str], first: dict, first_source: Path, record: dict, source: Path) -> None:
+    """InputError naming the cell and the field when `record` was played otherwise than the cell's `first` record:
+    another robot or camera mode, or a run identity differing in a field that decides how episodes play
+    (`run_identity.EPISODE_FIELDS`: runs of other seeds pool). Records from before run identities have none and
+    are compared by robot and camera mode alone; they do not pool with records that have one."""
+    fields = [name for name in ("robot", "camera_mode") if record[name] != first[name]]
+    runs = first.get(RUN_FIELD), record.get(RUN_FIELD)
+    if not isinstance(runs[1], dict | None):
+        raise InputError(f"{source / EPISODE_LOG_NAME}: a record of {cell[0]} {cell[1]} (seed {record['seed']}) has a "
+                         f"{RUN_FIELD!r} that is not a run identity (a JSON object)")
+    if not fields and (runs[0] is None) != (runs[1] is None):
+        fields = [RUN_FIELD]
+    elif not fields and runs[0] is not None:
+        fields = [f"{RUN_FIELD}.{name}" for name in differences(*runs, EPISODE_FIELDS)]
+    if fields:
+        def value(which: dict) -> str:
+            return json.dumps(_dotted(which, fields[0]))
+
+        place = f"in {source}" if source == first_source else f"in {first_source} and {source}"
+        raise InputError(f"{cell[0]} {cell[1]}: its episodes disagree on {fields[0]} ({value(first)} and "
+                         f"{value(record)}, {place}): they come from different runs")
+
+
+def _dotted(record: dict, name: str):
+    """record["a"]["b"] for name "a.b" (None where a level is missing)."""
+    for part in name.split("."):
+        record = record.get(part) if isinstance(record, dict) else None
+    return record
 
 
 def _order(cells) -> tuple[list[str], list[str]]:

@@ -16,6 +16,7 @@ from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.eval.cell_runs import run_cells
 from lerobot_tavis.eval.protocol import Cell, ProtocolConfig, run_protocol
 from lerobot_tavis.eval.report import write_report
+from lerobot_tavis.eval.run_identity import run_identity
 
 
 def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
@@ -81,6 +82,7 @@ def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
                          n_episodes=1, image_size=(24, 32), chunk_episodes=1)
     work = tmp_path / ".tavis_hands__id.chunks"
     work.mkdir(parents=True)
+    (work / "run.json").write_text(json.dumps(run_identity(cfg)))  # what the killed run wrote when it began
     stored = {"robot": "gr1t2", "suite": "tavis_hands", "task": "peeking_box", "task_id": 0, "split": "id",
               "camera_mode": "head_wrist", "seed": 1000, "success": False, "length_steps": 400, "prompt": "stored"}
     (work / "00_peeking_box_0001000.jsonl").write_text(json.dumps(stored) + "\n")
@@ -309,7 +311,7 @@ def test_a_policy_run_annotates_its_videos_while_it_plays(tmp_path):
     cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_hands",), tasks=("peeking_box",), splits=("id",),
                          n_episodes=2, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
                          policy_options=(("num_inference_steps", 1),), workers=2, chunk_episodes=1, film_episodes=1)
-    run_cells(cfg, [Cell("tavis_hands", "id")])
+    run_cells(cfg, [Cell("tavis_hands", "id")], run_identity(cfg))
     cell = tmp_path / "eval" / "tavis_hands__id"
     video = cell / "videos" / "tavis_hands_0" / "eval_episode_0.mp4"
     copy = cell / "videos_annotated" / "tavis_hands_0" / "eval_episode_0.mp4"

@@ -1,0 +1,74 @@
+"""One run at a time per output directory: an exclusive lock on the hidden file `.<name>.lock` beside it.
+
+The lock is the kernel's (`fcntl.flock`), held by the open file, so it goes with the process that took it, kill -9
+included: no stale lock survives a dead run. The file holds its holder's pid and command line, which a refused run
+quotes, and is removed when the run ends; it lies beside the directory, not in it, because staged outputs replace
+the whole directory when they are complete (`dataset_tools.staging`). Linux and macOS; no heavy imports.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import shlex
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from lerobot_tavis.errors import InputError
+
+
+class OutputInUseError(InputError):
+    """Another live process writes the same output directory."""
+
+
+def lock_path(directory: str | Path) -> Path:
+    """`.<name>.lock` beside `directory`, links resolved: two spellings of one directory share its lock."""
+    directory = Path(directory).resolve()
+    return directory.with_name(f".{directory.name}.lock")
+
+
+@contextmanager
+def exclusive_output(directory: str | Path) -> Iterator[None]:
+    """Hold `directory`'s lock for the block; OutputInUseError naming the holder (pid, command line) when another
+    process holds it. The directory itself is neither needed nor created; its parent is. The lock file is removed
+    when the block ends (a killed run leaves it, unlocked: the next run takes it over)."""
+    path = lock_path(directory)
+    fd = _locked(path, Path(directory))
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"pid {os.getpid()} ({shlex.join(_command_line())})\n".encode(), 0)
+        yield
+    finally:
+        path.unlink(missing_ok=True)  # while still locked: a run that opened it before fails, or finds it gone
+        os.close(fd)  # releases the lock
+
+
+def _locked(path: Path, directory: Path) -> int:
+    """An open descriptor of the lock file `path`, locked by this process."""
+    while True:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as error:
+            raise InputError(f"cannot create the lock file {path}: {error.strerror}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 4096, 0).decode(errors="replace").strip() or "another process"
+            os.close(fd)
+            raise OutputInUseError(f"{directory} is in use by {holder}: wait for it to end, or give another output "
+                                   "directory") from None
+        try:
+            if os.path.samestat(os.fstat(fd), os.stat(path)):
+                return fd
+        except FileNotFoundError:
+            pass
+        os.close(fd)  # its holder removed the file between our open and our lock: lock the new one
+
+
+def _command_line() -> list[str]:
+    """This process's command line as typed: `tavis ...` for the console script and `python -m lerobot_tavis.cli`."""
+    program = Path(sys.argv[0]).name if sys.argv and sys.argv[0] else "python"
+    return ["tavis" if program in ("tavis", "cli.py") else program, *sys.argv[1:]]
