@@ -37,7 +37,7 @@ class NoiseStateOptions:
 class PushOptions:
     root: Path = option(help="the dataset directory (a `tavis convert` output)", positional=True)
     repo_id: str = option(help="<user>/<name> on the Hub")
-    private: bool = False
+    private: bool = option(False, "make the Hub repository private")
     branch: str | None = option(None, "push to this branch (default: main)")
 
 
@@ -45,7 +45,7 @@ class PushOptions:
 class PullOptions:
     repo_id: str = option(help="<user>/<name> on the Hub", positional=True)
     root: Path | None = option(None, "where to put it (default: LeRobot's cache)")
-    revision: str | None = option(None, "branch, tag or commit")
+    revision: str | None = option(None, "branch, tag or commit (default: the tag of LeRobot's dataset format, v3.0)")
 
 
 @dataclass(frozen=True)
@@ -179,9 +179,25 @@ def _train(options: TrainOptions) -> None:
     sys.exit(subprocess.call(command))
 
 
+def version_line() -> str:
+    """`tavis --version`: this package's version and those of the packages a bug report needs, read from their
+    installed metadata (nothing is imported)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    def installed(name: str) -> str:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "not installed"
+
+    others = ", ".join(f"{name} {installed(name)}" for name in ("lerobot", "mujoco", "torch"))
+    return f"tavis (lerobot_env_tavis) {installed('lerobot_env_tavis')}; {others}"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The `tavis` parser: one subcommand per (name, options dataclass, run function, help) below."""
     parser = argparse.ArgumentParser(prog="tavis", description="TAVIS active-vision benchmark in MuJoCo")
+    parser.add_argument("--version", action="version", version=version_line())
     commands = parser.add_subparsers(dest="command", required=True, parser_class=CommandParser)
     for name, options, run, help in (
         ("demo", "lerobot_tavis.demo:DemoConfig", _printing("lerobot_tavis.demo:run_demo"),

@@ -95,25 +95,75 @@ def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     assert records[1]["prompt"] != "stored" and not work.exists()
 
 
-def _trained_checkpoint(path, env):
+def _trained_checkpoint(path, env, cameras=None, image_size=(120, 160)):
+    """A checkpoint's two config files (no weights): its policy reads `cameras` at `image_size`, its training ran
+    with the env `env`."""
     path.mkdir(parents=True)
+    images = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, *image_size]} for camera in cameras or ()}
+    (path / "config.json").write_text(json.dumps({"type": "diffusion", "input_features": images}))
     (path / "train_config.json").write_text(json.dumps({"env": env, "policy": {"type": "diffusion"}}))
     return path
 
 
-@pytest.mark.parametrize("extra,expected", [
-    ([], ("reachy2", "fixed_wrist", (120, 160))),  # all from the checkpoint's training config
-    (["--camera-mode", "head_only", "--image-size", "96x128"], ("reachy2", "head_only", (96, 128))),  # given wins
+@pytest.mark.parametrize("extra,expected,warned", [
+    ([], ("reachy2", "fixed_wrist", (120, 160)), []),  # all from the checkpoint's training config
+    (["--camera-mode", "head_only", "--image-size", "96x128"], ("reachy2", "head_only", (96, 128)),  # given wins,
+     ["trained with camera mode fixed_wrist; --camera-mode asks for head_only",  # with a warning for each
+      "trained on 120x160 images; --image-size asks for 96x128 (leave --image-size out"]),
 ])
-def test_tavis_eval_takes_robot_camera_mode_and_image_size_from_the_checkpoint(tmp_path, monkeypatch, extra,
-                                                                                expected):
+def test_tavis_eval_takes_robot_camera_mode_and_image_size_from_the_checkpoint(tmp_path, monkeypatch, caplog, extra,
+                                                                                expected, warned):
     checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {
         "type": "tavis", "robot": "reachy2", "camera_mode": "fixed_wrist", "image_size": [120, 160]})
     seen = []
     monkeypatch.setattr(protocol, "run_protocol", lambda cfg: seen.append(cfg) or [])
-    main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), *extra])
+    with caplog.at_level(logging.WARNING):
+        main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), *extra])
     (cfg,) = seen
     assert (cfg.robot, cfg.camera_mode, cfg.image_size) == expected
+    assert len(caplog.records) == len(warned)
+    assert all(text in record.getMessage() for text, record in zip(warned, caplog.records))
+
+
+def test_tavis_eval_takes_the_image_size_and_cameras_the_policy_reads(tmp_path, monkeypatch):
+    """Without a tavis training config (e.g. trained on another env's config), the policy's input features say
+    which cameras and which size it reads."""
+    checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {"type": "aloha"},
+                                     cameras=("fixed", "left_wrist", "right_wrist"), image_size=(96, 128))
+    seen = []
+    monkeypatch.setattr(protocol, "run_protocol", lambda cfg: seen.append(cfg) or [])
+    main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out")])
+    assert (seen[0].camera_mode, seen[0].image_size) == ("fixed_wrist", (96, 128))
+
+
+def test_tavis_eval_refuses_a_camera_mode_without_the_policys_cameras(tmp_path):
+    checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {"type": "tavis", "camera_mode": "fixed_wrist"},
+                                     cameras=("fixed", "left_wrist", "right_wrist"))
+    with pytest.raises(SystemExit, match="tavis eval: error: the policy reads the cameras fixed, left_wrist, "
+                                         "right_wrist, camera mode head_wrist renders head, left_wrist, right_wrist: "
+                                         "use --camera-mode fixed_wrist"):
+        main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), "--camera-mode", "head_wrist"])
+
+
+def test_expert_runs_refuse_an_image_size(tmp_path):
+    with pytest.raises(SystemExit, match="tavis eval: error: --image-size does not apply to --expert: the "
+                                         "demonstrators act on the simulator state and render nothing"):
+        main(["eval", "--expert", "--image-size", "96x128", "--out", str(tmp_path / "out")])
+
+
+def test_a_training_output_folder_names_its_checkpoint(tmp_path):
+    """`tavis eval --policy <lerobot-train output>`: the one-line error names the checkpoint folder to pass."""
+    train = tmp_path / "train"
+    for step in ("000800", "001600"):
+        _trained_checkpoint(train / "checkpoints" / step / "pretrained_model", {"type": "tavis"})
+    with pytest.raises(SystemExit, match=f"^tavis eval: error: {train} holds no config.json: pass "
+                                         f"{train}/checkpoints/001600/pretrained_model$"):
+        main(["eval", "--policy", str(train), "--out", str(tmp_path / "out")])
+    (train / "checkpoints" / "last").symlink_to("001600")
+    with pytest.raises(SystemExit, match=f"pass {train}/checkpoints/last/pretrained_model$"):
+        main(["eval", "--policy", str(train), "--out", str(tmp_path / "out")])
+    with pytest.raises(SystemExit, match=f"pass {train}/checkpoints/000800/pretrained_model$"):
+        main(["eval", "--policy", str(train / "checkpoints" / "000800"), "--out", str(tmp_path / "out")])
 
 
 def test_lerobot_options_pass_through_to_the_policy_and_the_env(tmp_path, monkeypatch):
