@@ -168,9 +168,10 @@ def _presets(options: PresetsOptions) -> None:
 def _train(options: TrainOptions) -> None:
     import subprocess
 
-    from lerobot_tavis.policy_configs import missing_pi0_downloads, preset_path
+    from lerobot_tavis.policy_configs import check_training_dataset, missing_pi0_downloads, preset_path
 
     path = preset_path(options.preset)
+    check_training_dataset(path, options.lerobot_args)
     if options.preset.startswith("pi0") and (missing := missing_pi0_downloads()):
         raise InputError(f"pi0 needs {', '.join(missing)}, which are neither in the Hugging Face cache nor "
                          "downloadable here: log in (`hf auth login`, and accept the PaliGemma licence on the Hub) "
@@ -222,7 +223,8 @@ def build_parser() -> argparse.ArgumentParser:
         ("pull", PullOptions, _pull, "download a TAVIS dataset from the Hugging Face Hub"),
         ("presets", PresetsOptions, _presets, "list the training presets, or print the path of one"),
         ("train", TrainOptions, _train,
-         "lerobot-train with a preset (checks pi0 downloads first); extra arguments go to lerobot-train"),
+         "lerobot-train with a preset (checks the dataset's cameras and image size and pi0 downloads first); extra "
+         "arguments go to lerobot-train"),
         ("report", ReportOptions, _report,
          "success rates with Wilson CIs, GALT, failure stages, plots from eval outputs"),
         ("curve", CurveOptions, _curve,

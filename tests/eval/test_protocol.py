@@ -334,6 +334,25 @@ def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path, envs, v
     assert all("galt_s" in r and r["length_steps"] == 10 for r in records)
 
 
+def test_lerobot_eval_of_a_checkpoint_renders_the_size_it_was_trained_at(tmp_path, monkeypatch, caplog):
+    """The issue's case: `lerobot-eval --policy.path=<checkpoint> --env.type=tavis` without `--env.image_size`
+    renders the checkpoint's size (32x48 here), not the env's default 480x640 (LeRobot's eval_main, in this
+    process)."""
+    from lerobot.scripts import lerobot_eval
+
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    monkeypatch.setattr("sys.argv", [
+        "lerobot-eval", "--env.type=tavis", "--env.task=conditional_pick", "--env.episode_length_s=0.2",
+        f"--policy.path={tmp_path / 'ckpt'}", "--policy.device=cpu", "--eval.n_episodes=1", "--eval.batch_size=1",
+        "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'out'}"])
+    monkeypatch.setenv("HF_HUB_OFFLINE", "1")
+    with caplog.at_level(logging.INFO, logger="lerobot_tavis.envs.config"):
+        lerobot_eval.eval_main()
+    assert "the env takes the checkpoint's image_size 32x48" in caplog.text
+    (record,) = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
+    assert record["length_steps"] == 4
+
+
 def test_the_eval_config_of_a_checkpoint_does_not_warn_of_random_weights(caplog):
     from lerobot.configs.eval import EvalPipelineConfig
     from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
