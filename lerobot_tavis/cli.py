@@ -42,6 +42,17 @@ class PushOptions:
 
 
 @dataclass(frozen=True)
+class PushPolicyOptions:
+    checkpoint: Path = option(help="the checkpoint's pretrained_model folder (<train output>/checkpoints/<step>/"
+                                   "pretrained_model)", positional=True)
+    repo_id: str = option(help="<user>/<name> of the model on the Hub")
+    results: Path | None = option(None, "a `tavis eval` or `tavis report` results.json: uploaded, and its success "
+                                        "rates written into the model card (default: none)")
+    private: bool = option(False, "make the Hub repository private")
+    branch: str | None = option(None, "push to this branch (default: main)")
+
+
+@dataclass(frozen=True)
 class PullOptions:
     repo_id: str = option(help="<user>/<name> on the Hub", positional=True)
     root: Path | None = option(None, "where to put it (default: LeRobot's cache)")
@@ -148,6 +159,13 @@ def _push(options: PushOptions) -> None:
     print(push_dataset(options.root, options.repo_id, private=options.private, branch=options.branch))
 
 
+def _push_policy(options: PushPolicyOptions) -> None:
+    from lerobot_tavis.policies.hub import push_policy
+
+    print(push_policy(options.checkpoint, options.repo_id, results=options.results, private=options.private,
+                      branch=options.branch))
+
+
 def _pull(options: PullOptions) -> None:
     from lerobot_tavis.dataset_tools.hub import pull_dataset
 
@@ -220,6 +238,8 @@ def build_parser() -> argparse.ArgumentParser:
         ("noise-state", NoiseStateOptions, _noise_state,
          "copy a dataset with Gaussian noise on the hand poses of observation.state (a training augmentation)"),
         ("push", PushOptions, _push, "upload a converted dataset to the Hugging Face Hub, with its card"),
+        ("push-policy", PushPolicyOptions, _push_policy,
+         "upload a trained policy checkpoint to the Hugging Face Hub, with a model card (and its results)"),
         ("pull", PullOptions, _pull, "download a TAVIS dataset from the Hugging Face Hub"),
         ("presets", PresetsOptions, _presets, "list the training presets, or print the path of one"),
         ("train", TrainOptions, _train,

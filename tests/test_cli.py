@@ -58,6 +58,9 @@ COMMAND_LINES = {
                          seed=3)),
     "push": (["dataset", "--repo-id", "me/tavis", "--private", "--branch", "v2"],
              dict(root=Path("dataset"), repo_id="me/tavis", private=True, branch="v2")),
+    "push-policy": (["ckpt", "--repo-id", "me/act", "--results", "results.json", "--private", "--branch", "v2"],
+                    dict(checkpoint=Path("ckpt"), repo_id="me/act", results=Path("results.json"), private=True,
+                         branch="v2")),
     "pull": (["me/tavis", "--root", "here", "--revision", "v2"],
              dict(repo_id="me/tavis", root=Path("here"), revision="v2")),
     "presets": (["diffusion_head_wrist"], dict(name="diffusion_head_wrist")),
@@ -80,6 +83,7 @@ MINIMAL = {
     "noise-state": (["dataset", "--out", "noisy", "--position-m", "0.02", "--rotation-deg", "5"],
                     dict(source_root=Path("dataset"), out_root=Path("noisy"), position_m=0.02, rotation_deg=5.0)),
     "push": (["dataset", "--repo-id", "me/tavis"], dict(root=Path("dataset"), repo_id="me/tavis")),
+    "push-policy": (["ckpt", "--repo-id", "me/act"], dict(checkpoint=Path("ckpt"), repo_id="me/act")),
     "pull": (["me/tavis"], dict(repo_id="me/tavis")),
     "presets": ([], {}),
     "train": (["diffusion_head_wrist"], dict(preset="diffusion_head_wrist", lerobot_args=())),
@@ -87,6 +91,14 @@ MINIMAL = {
     "curve": (["evals"], dict(eval_root=Path("evals"))),
 }
 OFF_THE_COMMAND_LINE = {"record": {"max_attempts_factor"}, "view": {"max_frames"}}
+
+
+@pytest.fixture(autouse=True)
+def offline(monkeypatch):
+    """The eval command line names a Hub policy, whose config files `tavis eval` fetches: none is reachable."""
+    from huggingface_hub import constants
+
+    monkeypatch.setattr(constants, "HF_HUB_OFFLINE", True)
 
 
 def _subcommands() -> dict:

@@ -159,14 +159,15 @@ class ProtocolConfig:
 
 def _checkpoint_settings(policy_path: str) -> CheckpointSettings:
     """What the checkpoint says of its env: a local checkpoint's (a folder without config.json is refused, naming
-    the checkpoint below it), a Hub repo's from the Hugging Face cache; a path that is neither is refused."""
+    the checkpoint below it), a Hub repo's (its config files downloaded, as the run would); a path that is neither
+    is refused."""
     if Path(policy_path).exists():
         return read_checkpoint_settings(pretrained_model_dir(policy_path))
     try:
         checks.repo_id(policy_path)
     except FieldError:
         raise FieldError("policy_path", f"{policy_path}: no such checkpoint directory") from None
-    return read_checkpoint_settings(policy_path)
+    return read_checkpoint_settings(policy_path, download=True)
 
 
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:

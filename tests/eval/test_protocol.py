@@ -136,6 +136,20 @@ def test_tavis_eval_takes_the_image_size_and_cameras_the_policy_reads(tmp_path, 
     assert (seen[0].camera_mode, seen[0].image_size) == ("fixed_wrist", (96, 128))
 
 
+def test_tavis_eval_of_a_hub_policy_fetches_its_settings(tmp_path, monkeypatch):
+    """A published baseline (`--policy <user>/<name>`): its two config files come from the Hub (faked here)."""
+    import huggingface_hub
+
+    published = _trained_checkpoint(tmp_path / "hub", {"type": "tavis", "robot": "reachy2"},
+                                     cameras=("head", "left_wrist", "right_wrist"), image_size=(96, 128))
+    fetched = []
+    monkeypatch.setattr(huggingface_hub, "hf_hub_download",
+                        lambda repo_id, name: fetched.append((repo_id, name)) or str(published / name))
+    cfg = ProtocolConfig(policy_path="someone/act", out_dir=tmp_path / "out")
+    assert (cfg.robot, cfg.camera_mode, cfg.image_size) == ("reachy2", "head_wrist", (96, 128))
+    assert fetched == [("someone/act", "config.json"), ("someone/act", "train_config.json")]
+
+
 def test_tavis_eval_refuses_a_camera_mode_without_the_policys_cameras(tmp_path):
     checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {"type": "tavis", "camera_mode": "fixed_wrist"},
                                      cameras=("fixed", "left_wrist", "right_wrist"))
