@@ -93,7 +93,8 @@ class ProtocolConfig:
     device: str = "cpu"
     episode_length_s: float = option(20.0, "seconds per episode (default 20)")
     policy_options: tuple[tuple[str, object], ...] = option(  # (field, value) set on the checkpoint's policy config
-        (), "set a field of the checkpoint's policy config, e.g. num_inference_steps=10 or use_amp=true (repeatable; default: none)",
+        (), "set a field of the checkpoint's policy config, e.g. num_inference_steps=10 or use_amp=true (repeatable; "
+        "default: none)",
         flag="--policy-option", action="append", metavar="FIELD=VALUE", parse=policy_options)
     workers: int = option(1, "(cell, task, seed chunk) jobs at once; with a policy on a GPU they share it")
     chunk_episodes: int | None = option(None, "consecutive episodes per job, also what a killed run loses at most "
@@ -110,9 +111,7 @@ class ProtocolConfig:
         if bool(self.policy_path) == self.expert:
             raise InputError("give exactly one of --policy PATH and --expert")
         object.__setattr__(self, "policy_path", self.policy_path or None)
-        if self.image_size is not None:
-            checks.image_size(self.image_size)
-        if self.expert and self.image_size is not None:
+        if self.image_size is not None and checks.image_size(self.image_size) and self.expert:
             raise FieldError("image_size", "does not apply to --expert: the demonstrators act on the simulator state "
                                            "and render nothing")
         if self.camera_mode is not None:

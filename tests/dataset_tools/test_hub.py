@@ -248,7 +248,8 @@ def test_policy_card_names_env_robot_task_cameras_data_recipe_commands_and_resul
                  "lerobot-train --config_path=$(tavis presets act_hand_relative_head_wrist_compact) "
                  "--dataset.repo_id=someone/tavis-head-gr1t2 --env.task=conditional_pick --steps=3200 "
                  "--batch_size=128 --seed=1000",
-                 "on gr1t2 with camera mode head_wrist", "| `conditional_pick` | id | 96 | 40.6% | [31.3, 50.6] | 0.80 |",
+                 "on gr1t2 with camera mode head_wrist",
+                 "| `conditional_pick` | id | 96 | 40.6% | [31.3, 50.6] | 0.80 |",
                  "@misc{tavis,"):
         assert text in card, text
     assert "/data/tavis" not in card  # the machine's path stays private
