@@ -20,7 +20,7 @@ from lerobot_tavis.eval.report import write_report
 
 def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
     cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",),
-                         n_episodes=2, image_size=(24, 32), workers=1)
+                         n_episodes=2, workers=1)
     written = {p.name for p in run_protocol(cfg)}
     assert {"results.md", "results.json", "success_rates.png"} <= written
     cell = tmp_path / "tavis_hands__id"
@@ -42,7 +42,7 @@ def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
 
 def test_tasks_play_only_those_tasks_and_a_cell_of_other_tasks_is_not_reused(tmp_path):
     cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", splits=("id",), tasks=("occluded_reach",),
-                         n_episodes=2, image_size=(24, 32))
+                         n_episodes=2)
     assert cfg.suites == ("tavis_hands",)  # the task's suite
     run_protocol(cfg)
     assert [path.name for path in tmp_path.glob("*__*")] == ["tavis_hands__id"]
@@ -53,7 +53,7 @@ def test_tasks_play_only_those_tasks_and_a_cell_of_other_tasks_is_not_reused(tmp
     assert [(r["task"], r["seed"]) for r in records] == [("occluded_reach", 1000), ("occluded_reach", 1001)]
     with pytest.raises(InputError, match="holds the tasks \\['occluded_reach'\\], not those asked for"):
         run_protocol(ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",),
-                                    splits=("id",), n_episodes=2, image_size=(24, 32)))
+                                    splits=("id",), n_episodes=2))
 
 
 def test_a_task_outside_the_suites_is_refused(tmp_path):
@@ -67,8 +67,7 @@ def _cell_files(root, cell="tavis_hands__id"):
 
 def test_expert_results_do_not_depend_on_workers_or_chunking(tmp_path):
     """Chunks of one seed finish in any order over 2 workers; the cell is the same as one process playing all."""
-    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2,
-                  image_size=(24, 32))
+    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2)
     run_protocol(ProtocolConfig(out_dir=tmp_path / "one", workers=1, **common))
     run_protocol(ProtocolConfig(out_dir=tmp_path / "two", workers=2, chunk_episodes=1, **common))
     assert _cell_files(tmp_path / "one") == _cell_files(tmp_path / "two")
@@ -78,7 +77,7 @@ def test_expert_results_do_not_depend_on_workers_or_chunking(tmp_path):
 def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     """A chunk whose `done` record exists is not played again: its stored outcome is what the cell reports."""
     cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",),
-                         n_episodes=1, image_size=(24, 32), chunk_episodes=1)
+                         n_episodes=1, chunk_episodes=1)
     work = tmp_path / ".tavis_hands__id.chunks"
     work.mkdir(parents=True)
     stored = {"robot": "gr1t2", "suite": "tavis_hands", "task": "peeking_box", "task_id": 0, "split": "id",
