@@ -97,17 +97,15 @@ def _run(python: str, steps: int, *one: str) -> dict | None:
 
 
 def main() -> None:
-    from lerobot_tavis.envs.robots import BUILTIN_ROBOTS
-
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--steps", type=int, default=200)
-    parser.add_argument("--robots", nargs="+", default=list(BUILTIN_ROBOTS))
+    parser.add_argument("--robots", nargs="+", help="default: every built-in robot")
     parser.add_argument("--shadows", action="store_true", help="also measure with shadows on")
     parser.add_argument("--repeats", type=int, default=1, help="round-robin rounds; medians are reported")
     parser.add_argument("--peer-python", default=sys.executable, help="interpreter in which gym_aloha imports")
     parser.add_argument("--one", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
-    if args.one:
+    if args.one:  # a measurement process; the peer's (`aloha`) may run where lerobot_tavis is not installed
         if args.one[0] == "aloha":
             print(json.dumps(measure_aloha(args.steps)))
         else:
@@ -115,6 +113,9 @@ def main() -> None:
             print(json.dumps(measure(robot, mode, (int(h), int(w)), args.steps, shadows == "on")))
         return
 
+    from lerobot_tavis.envs.robots import BUILTIN_ROBOTS
+
+    args.robots = args.robots or list(BUILTIN_ROBOTS)
     configs = [(robot, mode, size, shadows) for robot in args.robots for mode, size in CONFIGS
                for shadows in (("off", "on") if args.shadows else ("off",))]
     results = {config: [] for config in configs}

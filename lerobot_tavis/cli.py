@@ -38,7 +38,18 @@ class NoiseStateOptions:
 class PushOptions:
     root: Path = option(help="the dataset directory (a `tavis convert` output)", positional=True)
     repo_id: str = option(help="<user>/<name> on the Hub")
-    private: bool = False
+    private: bool = option(False, "make the Hub repository private")
+    branch: str | None = option(None, "push to this branch (default: main)")
+
+
+@dataclass(frozen=True)
+class PushPolicyOptions:
+    checkpoint: Path = option(help="the checkpoint's pretrained_model folder (<train output>/checkpoints/<step>/"
+                                   "pretrained_model)", positional=True)
+    repo_id: str = option(help="<user>/<name> of the model on the Hub")
+    results: Path | None = option(None, "a `tavis eval` or `tavis report` results.json: uploaded, and its success "
+                                        "rates written into the model card (default: none)")
+    private: bool = option(False, "make the Hub repository private")
     branch: str | None = option(None, "push to this branch (default: main)")
 
 
@@ -46,7 +57,7 @@ class PushOptions:
 class PullOptions:
     repo_id: str = option(help="<user>/<name> on the Hub", positional=True)
     root: Path | None = option(None, "where to put it (default: LeRobot's cache)")
-    revision: str | None = option(None, "branch, tag or commit")
+    revision: str | None = option(None, "branch, tag or commit (default: the tag of LeRobot's dataset format, v3.0)")
 
 
 @dataclass(frozen=True)
@@ -156,6 +167,13 @@ def _push(options: PushOptions) -> None:
     print(push_dataset(options.root, options.repo_id, private=options.private, branch=options.branch))
 
 
+def _push_policy(options: PushPolicyOptions) -> None:
+    from lerobot_tavis.policies.hub import push_policy
+
+    print(push_policy(options.checkpoint, options.repo_id, results=options.results, private=options.private,
+                      branch=options.branch))
+
+
 def _pull(options: PullOptions) -> None:
     from lerobot_tavis.dataset_tools.hub import pull_dataset
 
@@ -176,9 +194,10 @@ def _presets(options: PresetsOptions) -> None:
 def _train(options: TrainOptions) -> None:
     import subprocess
 
-    from lerobot_tavis.policy_configs import missing_pi0_downloads, preset_path
+    from lerobot_tavis.policy_configs import check_training_dataset, missing_pi0_downloads, preset_path
 
     path = preset_path(options.preset)
+    check_training_dataset(path, options.lerobot_args)
     if options.preset.startswith("pi0") and (missing := missing_pi0_downloads()):
         raise InputError(f"pi0 needs {', '.join(missing)}, which are neither in the Hugging Face cache nor "
                          "downloadable here: log in (`hf auth login`, and accept the PaliGemma licence on the Hub) "
@@ -187,9 +206,25 @@ def _train(options: TrainOptions) -> None:
     sys.exit(subprocess.call(command))
 
 
+def version_line() -> str:
+    """`tavis --version`: this package's version and those of the packages a bug report needs, read from their
+    installed metadata (nothing is imported)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    def installed(name: str) -> str:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "not installed"
+
+    others = ", ".join(f"{name} {installed(name)}" for name in ("lerobot", "mujoco", "torch"))
+    return f"tavis (lerobot_env_tavis) {installed('lerobot_env_tavis')}; {others}"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The `tavis` parser: one subcommand per (name, options dataclass, run function, help) below."""
     parser = argparse.ArgumentParser(prog="tavis", description="TAVIS active-vision benchmark in MuJoCo")
+    parser.add_argument("--version", action="version", version=version_line())
     commands = parser.add_subparsers(dest="command", required=True, parser_class=CommandParser)
     for name, options, run, help in (
         ("demo", "lerobot_tavis.demo:DemoConfig", _printing("lerobot_tavis.demo:run_demo"),
@@ -214,10 +249,13 @@ def build_parser() -> argparse.ArgumentParser:
         ("noise-state", NoiseStateOptions, _noise_state,
          "copy a dataset with Gaussian noise on the hand poses of observation.state (a training augmentation)"),
         ("push", PushOptions, _push, "upload a converted dataset to the Hugging Face Hub, with its card"),
+        ("push-policy", PushPolicyOptions, _push_policy,
+         "upload a trained policy checkpoint to the Hugging Face Hub, with a model card (and its results)"),
         ("pull", PullOptions, _pull, "download a TAVIS dataset from the Hugging Face Hub"),
         ("presets", PresetsOptions, _presets, "list the training presets, or print the path of one"),
         ("train", TrainOptions, _train,
-         "lerobot-train with a preset (checks pi0 downloads first); extra arguments go to lerobot-train"),
+         "lerobot-train with a preset (checks the dataset's cameras and image size and pi0 downloads first); extra "
+         "arguments go to lerobot-train"),
         ("report", ReportOptions, _report,
          "success rates with Wilson CIs, GALT, failure stages, plots from eval outputs"),
         ("curve", CurveOptions, _curve,

@@ -5,7 +5,9 @@ A field is one option: its name gives the flag (`episodes_per_task` -> `--episod
 without one is a required option). `option()` adds what the type cannot say: help text, choices (a callable is
 called when the parser is built, so registered names count), another spelling, a positional argument, a function
 turning the command-line text into the field's value. Options left out of the command line are not set by argparse:
-the dataclass's own defaults apply.
+the dataclass's own defaults apply. Every optional option's help ends with its default: written in the help text
+where it says "default" (a default that needs words, such as None or one a `parse` function reads), else appended
+from the field's value.
 """
 
 from __future__ import annotations
@@ -72,7 +74,7 @@ def add_options(parser: argparse.ArgumentParser, cls: type) -> None:
     for field in command_fields(cls):
         settings, kind = spec(field), _without_none(hints[field.name])
         kwargs = {} if settings.parse else _inferred(kind)
-        kwargs.update({key: value for key, value in (("help", settings.help), ("nargs", settings.nargs),
+        kwargs.update({key: value for key, value in (("help", _help(field, settings)), ("nargs", settings.nargs),
                                                      ("action", settings.action), ("metavar", settings.metavar))
                        if value is not None})
         if settings.choices is not None:
@@ -126,6 +128,28 @@ class CommandParser(argparse.ArgumentParser):
     def parse_known_args(self, args=None, namespace=None):
         self.load_options()
         return super().parse_known_args(args, namespace)
+
+
+def _help(field: dataclasses.Field, settings: OptionSpec) -> str | None:
+    """The option's help text, ending with "(default: <value>)" when the field has a default the text does not state
+    and that reads as typed on the command line: off for a switch, a number, a word, a path, a list of them."""
+    text = settings.help
+    if field.default is not dataclasses.MISSING:
+        default = field.default
+    elif field.default_factory is not dataclasses.MISSING:
+        default = field.default_factory()
+    else:
+        return text
+    if (text and "default" in text) or settings.parse is not None or default is None or default == ():
+        return text
+    if default is False:
+        shown = "off"
+    elif isinstance(default, tuple):
+        shown = " ".join(str(value) for value in default)
+    else:
+        shown = str(default)
+    shown = f"(default: {shown})".replace("%", "%%")  # argparse formats help texts with %
+    return f"{text} {shown}" if text else shown
 
 
 def _without_none(kind):

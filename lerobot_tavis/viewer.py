@@ -20,11 +20,12 @@ import numpy as np
 
 from lerobot_tavis import checks
 from lerobot_tavis.cli_options import option
+from lerobot_tavis.envs.checkpoint_settings import pretrained_model_dir, read_checkpoint_settings
 from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS
 from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import split_names, task_names
-from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError
+from lerobot_tavis.errors import FieldError, InputError, TavisError
 from lerobot_tavis.policies import register_policy_types
 
 DRIVERS = ("demonstrator", "policy", "paused")
@@ -105,9 +106,7 @@ class PolicyDriver:
 
         register_policy_types()
 
-        path = Path(policy_path)
-        if not (path / "config.json").is_file():
-            raise PathNotFoundError(f"{path} holds no config.json: pass a checkpoint's pretrained_model folder")
+        path = pretrained_model_dir(policy_path)
         config = PreTrainedConfig.from_pretrained(path)
         config.device = device
         self.policy = get_policy_class(config.type).from_pretrained(path, config=config).to(device).eval()
@@ -140,7 +139,8 @@ class ViewConfig:
     seed: int = 1000
     driver: str | None = option(None, "who acts (default: the policy when --policy is given, else the demonstrator)",
                                 choices=DRIVERS)
-    policy: str | None = option(None, "a checkpoint's pretrained_model folder; its camera mode and image size apply")
+    policy: str | None = option(None, "a checkpoint's pretrained_model folder; its camera mode and image size apply "
+                                "(default: none)")
     device: str = option("cpu", "the policy's device (default cpu)")
     camera: str = option(FREE_CAMERA, "the window's camera (default: the free camera, moved with the mouse)",
                          choices=WINDOW_CAMERAS)
@@ -165,9 +165,7 @@ def view(cfg: ViewConfig) -> int:
     from lerobot_tavis.experts.registry import make_expert
 
     if cfg.policy is not None:
-        from lerobot_tavis.eval.protocol import checkpoint_env
-
-        settings = checkpoint_env(cfg.policy)
+        settings = read_checkpoint_settings(pretrained_model_dir(cfg.policy)).known()
         driver, fps = PolicyDriver(cfg.policy, cfg.device), POLICY_HZ
         env = TavisEnv(cfg.task, cfg.robot or settings.get("robot", "gr1t2"), split=cfg.split, fps=fps,
                        camera_mode=settings.get("camera_mode", "head_wrist"),

@@ -24,12 +24,12 @@ COMMAND_LINES = {
                  "--seed", "2"],
                 dict(out_dir=Path("stills"), robots=("gr1t2",), tasks=("conditional_pick",), image_size=(96, 128),
                      seed=2)),
-    "eval": (["--expert", "--robot", "reachy2", "--suite", "tavis_hands", "tavis_head", "--splits", "id",
+    "eval": (["--policy", "me/policy", "--robot", "reachy2", "--suite", "tavis_hands", "tavis_head", "--splits", "id",
               "ood_visual:table", "--episodes", "2", "--camera-mode", "fixed_wrist", "--image-size", "96x128",
               "--batch-size", "2", "--device", "cuda:1", "--episode-length-s", "5.5", "--policy-option", "steps=10",
               "--policy-option", "name=DDIM", "--workers", "3", "--chunk-episodes", "4", "--backend", "ray",
               "--seed", "7", "--out", "evals"],
-             dict(policy_path=None, expert=True, robot="reachy2", suites=("tavis_hands", "tavis_head"),
+             dict(policy_path="me/policy", expert=False, robot="reachy2", suites=("tavis_hands", "tavis_head"),
                   splits=("id", "ood_visual:table"), n_episodes=2, camera_mode="fixed_wrist", image_size=(96, 128),
                   batch_size=2, device="cuda:1", episode_length_s=5.5, policy_options=(("steps", 10), ("name", "DDIM")),
                   workers=3, chunk_episodes=4, backend="ray", seed=7, out_dir=Path("evals"))),
@@ -60,6 +60,9 @@ COMMAND_LINES = {
                          seed=3)),
     "push": (["dataset", "--repo-id", "me/tavis", "--private", "--branch", "v2"],
              dict(root=Path("dataset"), repo_id="me/tavis", private=True, branch="v2")),
+    "push-policy": (["ckpt", "--repo-id", "me/act", "--results", "results.json", "--private", "--branch", "v2"],
+                    dict(checkpoint=Path("ckpt"), repo_id="me/act", results=Path("results.json"), private=True,
+                         branch="v2")),
     "pull": (["me/tavis", "--root", "here", "--revision", "v2"],
              dict(repo_id="me/tavis", root=Path("here"), revision="v2")),
     "presets": (["diffusion_head_wrist"], dict(name="diffusion_head_wrist")),
@@ -84,6 +87,7 @@ MINIMAL = {
     "noise-state": (["dataset", "--out", "noisy", "--position-m", "0.02", "--rotation-deg", "5"],
                     dict(source_root=Path("dataset"), out_root=Path("noisy"), position_m=0.02, rotation_deg=5.0)),
     "push": (["dataset", "--repo-id", "me/tavis"], dict(root=Path("dataset"), repo_id="me/tavis")),
+    "push-policy": (["ckpt", "--repo-id", "me/act"], dict(checkpoint=Path("ckpt"), repo_id="me/act")),
     "pull": (["me/tavis"], dict(repo_id="me/tavis")),
     "presets": ([], {}),
     "train": (["diffusion_head_wrist"], dict(preset="diffusion_head_wrist", lerobot_args=())),
@@ -92,6 +96,14 @@ MINIMAL = {
     "compare": (["a", "b"], dict(eval_a=Path("a"), eval_b=Path("b"))),
 }
 OFF_THE_COMMAND_LINE = {"record": {"max_attempts_factor"}, "view": {"max_frames"}}
+
+
+@pytest.fixture(autouse=True)
+def offline(monkeypatch):
+    """The eval command line names a Hub policy, whose config files `tavis eval` fetches: none is reachable."""
+    from huggingface_hub import constants
+
+    monkeypatch.setattr(constants, "HF_HUB_OFFLINE", True)
 
 
 def _subcommands() -> dict:
@@ -130,6 +142,37 @@ def test_options_left_out_take_the_dataclass_defaults(name):
     argv, given = MINIMAL[name]
     parsed = _options([name, *argv])
     assert parsed == type(parsed)(**given)
+
+
+def test_every_optional_option_shows_its_default_in_its_help():
+    for name, parser in _subcommands().items():
+        parser.load_options()
+        for action in parser._actions:
+            if action.option_strings and not action.required and action.dest != "help":
+                assert "default" in (action.help or ""), f"tavis {name} {action.option_strings[0]}: {action.help!r}"
+
+
+def _help(command: str, flag: str) -> str:
+    parser = _subcommands()[command]
+    parser.load_options()
+    return next(action.help for action in parser._actions if flag in action.option_strings)
+
+
+def test_a_default_the_help_does_not_state_is_appended():
+    assert _help("push", "--private") == "make the Hub repository private (default: off)"
+    assert _help("record", "--seed-start") == "first seed (evaluation uses 1000..) (default: 100000)"
+    assert _help("record", "--backend").endswith("(default: local)")
+    assert _help("eval", "--film-episodes").count("default") == 1  # stated by the help text: not twice
+
+
+def test_version_names_the_package_and_its_main_dependencies(capsys):
+    from importlib.metadata import version
+
+    with pytest.raises(SystemExit) as done:
+        build_parser().parse_args(["--version"])
+    assert done.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"tavis (lerobot_env_tavis) {version('lerobot_env_tavis')}; lerobot {version('lerobot')}")
 
 
 LEAN = """

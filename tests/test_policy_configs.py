@@ -4,6 +4,7 @@ without the state input (absolute or hand-frame actions) trains and runs in `tav
 
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -180,6 +181,41 @@ def test_pi0_presets_say_clearly_what_is_missing_offline(tmp_path):
     assert result.returncode == 1
     assert "tavis train: error: pi0 needs lerobot/pi0_base" in result.stderr
     assert "google/paligemma-3b-pt-224" in result.stderr
+
+
+def _dataset_info(root, cameras, size):
+    """A dataset's meta/info.json alone: what `tavis train` reads of it."""
+    (root / "meta").mkdir(parents=True)
+    features = {f"observation.images.{camera}": {"dtype": "video", "shape": [*size, 3]} for camera in cameras}
+    (root / "meta" / "info.json").write_text(json.dumps({"features": features}))
+    return root
+
+
+@pytest.mark.parametrize(("preset", "cameras", "size", "refused"), [
+    ("act_head_wrist_compact", ("head", "left_wrist", "right_wrist"), (96, 128),
+     "the dataset's head images are 96x128, the policy's input_features say 120x160 (and evaluation renders that): "
+     "convert the dataset with --image-size 120x160"),
+    ("act_hand_relative_fixed_wrist_compact", ("head", "left_wrist", "right_wrist"), (120, 160),
+     "the policy reads the cameras fixed, left_wrist, right_wrist, the dataset has head, left_wrist, right_wrist: "
+     "convert the dataset with --cameras fixed,left_wrist,right_wrist"),
+    ("diffusion_head_wrist", ("head", "fixed", "left_wrist", "right_wrist"), (480, 640), None),  # resizes its images
+    ("act_head_wrist_compact", ("head", "fixed", "left_wrist", "right_wrist"), (120, 160), None),
+])
+def test_tavis_train_checks_the_datasets_cameras_and_image_size_first(tmp_path, monkeypatch, preset, cameras, size,
+                                                                        refused):
+    import subprocess as processes
+
+    root = _dataset_info(tmp_path / "dataset", cameras, size)
+    started = []
+    monkeypatch.setattr(processes, "call", lambda command: started.append(command) or 0)
+    if refused is None:
+        with pytest.raises(SystemExit) as done:
+            main(["train", preset, f"--dataset.root={root}"])
+        assert done.value.code == 0 and len(started) == 1
+        return
+    with pytest.raises(SystemExit, match=f"^tavis train: error: {re.escape(refused)}"):
+        main(["train", preset, "--dataset.root", str(root)])
+    assert started == []
 
 
 def test_presets_command_lists_and_locates(capsys):

@@ -49,7 +49,7 @@ def _cell(root: Path, name: str = "tavis_hands__id") -> tuple[str, dict]:
 
 def test_demonstrator_protocol_on_ray_equals_local(tmp_path, ray_cluster):
     common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2,
-                  image_size=(24, 32), chunk_episodes=1)
+                  chunk_episodes=1)
     run_protocol(ProtocolConfig(out_dir=tmp_path / "local", workers=1, **common))
     run_protocol(ProtocolConfig(out_dir=tmp_path / "ray", workers=2, backend="ray", **common))
     assert _cell(tmp_path / "ray") == _cell(tmp_path / "local")

@@ -53,15 +53,16 @@ class ConvertConfig:
     episodes, the source size for an original dataset."""
 
     raw_dir: Path | None = option(help="a `tavis record` output directory", positional=True)
-    from_tavis: Path | None = option(None, "convert an original TAVIS dataset (60 Hz) instead", metavar="ROOT",
-                                     kw_only=True)
+    from_tavis: Path | None = option(None, "convert an original TAVIS dataset (60 Hz) instead (default: none, "
+                                     "convert RAW_DIR)", metavar="ROOT", kw_only=True)
     repo_id: str = option(help="dataset id, e.g. <user>/tavis-head-gr1t2")
     root: Path = option(help="destination directory (must not exist unless --overwrite)")
     fps: int = option(20, "dataset rate; must divide 60 (default 20)")
     image_size: tuple[int, int] | None = option(None, "HxW of every camera (default 480x640; --from-tavis: the "
                                                 "source size)", parse=checks.image_size_text)
-    cameras: tuple[str, ...] = option(ft.CAMERAS, "comma list of cameras", parse=ft.parse_cameras)
-    task: str | None = option(None, "convert only this task")
+    cameras: tuple[str, ...] = option(ft.CAMERAS, f"comma list of cameras (default: {','.join(ft.CAMERAS)})",
+                                      parse=ft.parse_cameras)
+    task: str | None = option(None, "convert only this task (default: every task)")
     overwrite: bool = option(False, "replace an existing destination")
     storage: str = option("av1", "camera frames as AV1 video (LeRobot's default, smallest), all-intra H.264 video "
                           "(fast random access for training) or PNG images (no video decoding; largest)",

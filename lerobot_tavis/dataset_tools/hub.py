@@ -119,7 +119,7 @@ def push_dataset(root: str | Path, repo_id: str, *, private: bool = False, branc
         raise HubError(NOT_LOGGED_IN)
     dataset = LeRobotDataset(repo_id, root=root, video_backend="pyav")  # nothing is decoded here
     card = dataset_card(dataset, provenance=provenance)
-    with _hub_errors(repo_id):
+    with hub_errors(repo_id):
         dataset.push_to_hub(branch=branch, tags=list(TAGS), license=LICENSE, tag_version=False, private=private)
         api = HfApi()
         api.upload_file(path_or_fileobj=card.encode(), path_in_repo="README.md", repo_id=repo_id,
@@ -148,7 +148,7 @@ def pull_dataset(repo_id: str, root: str | Path | None = None, revision: str | N
         check_files(local)
     except InputError as error:
         raise InputError(f"{error}; remove it to download it again") from None
-    with _hub_errors(repo_id):
+    with hub_errors(repo_id):
         return LeRobotDataset(repo_id, root=root, revision=revision, video_backend=video_backend())
 
 
@@ -185,8 +185,9 @@ def _feature_content(key: str) -> str:
 
 
 @contextlib.contextmanager
-def _hub_errors(repo_id: str) -> Iterator[None]:
-    """Turn the Hub's authentication, network and not-found exceptions into a one-line `HubError`."""
+def hub_errors(repo_id: str, kind: str = "dataset") -> Iterator[None]:
+    """Turn the Hub's authentication, network and not-found exceptions into a one-line `HubError`; `kind` names
+    what `repo_id` holds (dataset, model)."""
     import httpx
     from huggingface_hub import constants
     from huggingface_hub.errors import (GatedRepoError, HfHubHTTPError, LocalEntryNotFoundError, OfflineModeIsEnabled,
@@ -202,11 +203,11 @@ def _hub_errors(repo_id: str) -> Iterator[None]:
         raise HubError(f"{repo_id} is gated on the Hugging Face Hub: request access on its page, then log in "
                        "(`hf auth login` or HF_TOKEN)") from exc
     except RepositoryNotFoundError as exc:
-        raise HubError(f"dataset {repo_id} was not found on the Hugging Face Hub at {endpoint} (a private one "
+        raise HubError(f"{kind} {repo_id} was not found on the Hugging Face Hub at {endpoint} (a private one "
                        "needs `hf auth login` or HF_TOKEN)") from exc
     except RevisionNotFoundError as exc:
         detail = str(exc).splitlines()[0] if str(exc) else "revision not found"
-        raise HubError(f"dataset {repo_id} on the Hugging Face Hub at {endpoint}: {detail}") from exc
+        raise HubError(f"{kind} {repo_id} on the Hugging Face Hub at {endpoint}: {detail}") from exc
     except HfHubHTTPError as exc:
         status = exc.response.status_code
         if status == 401:

@@ -16,7 +16,7 @@ directory: `make_env` calls `create_envs(n_envs, use_async_envs)` with the env c
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from functools import partial
 from pathlib import Path
 
@@ -26,6 +26,7 @@ from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.envs.configs import EnvConfig
 
 from lerobot_tavis import canonical, checks
+from lerobot_tavis.envs.checkpoint_settings import SETTINGS, match_settings, read_checkpoint_settings
 from lerobot_tavis.envs.factory import EPISODE_LOG_NAME, make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_info
@@ -83,10 +84,14 @@ class TavisEnvConfig(EnvConfig):
         parse_split(self.split)  # raises a clear error for an unknown split or ood_visual factor
         if self.fps != 20:
             raise FieldError("fps", f"is fixed by the benchmark at 20, got {self.fps}")
-        height, width = checks.image_size(self.image_size)
         checks.episode_steps(self.episode_length_s, self.fps)
         checks.integer("filmed_envs", self.filmed_envs, 0)
         checks.integer("worker_niceness", self.worker_niceness, 0, MAX_NICENESS)
+        self._derive_features()
+
+    def _derive_features(self) -> None:
+        """`features` and `features_map` from `camera_mode` and `image_size`."""
+        height, width = checks.image_size(self.image_size)
         self.features = {"action": PolicyFeature(FeatureType.ACTION, (canonical.ACTION_DIM,)),
                          "agent_pos": PolicyFeature(FeatureType.STATE, (canonical.ACTION_DIM,))}
         self.features_map = {"action": "action", "agent_pos": "observation.state"}
@@ -107,7 +112,36 @@ class TavisEnvConfig(EnvConfig):
                         for task_id, task in enumerate(tasks)}
                 for suite, tasks in expand_tasks(self.task).items()}
 
+    def match_command_line_policy(self, args: list[str] | None = None) -> None:
+        """Match robot, camera mode and image size to the checkpoint of `--policy.path` on the command line (default:
+        sys.argv; lerobot-eval's, or lerobot-train's when it fine-tunes one), as `checkpoint_settings.match_settings`
+        does: a setting left at its default and off the command line takes the checkpoint's (logged), a difference
+        from one the user gave is logged as a warning, a camera the policy reads and the camera mode does not render
+        is refused. LeRobot 0.6.1 passes `create_envs` the env config alone: the command line is where the policy
+        can be seen."""
+        policy_path = parser.get_path_arg("policy", args)
+        if not policy_path:
+            return
+        checkpoint = read_checkpoint_settings(policy_path, download=True)
+        defaults = {item.name: item.default for item in fields(self) if item.name in SETTINGS}
+        current = {name: tuple(value) if name == "image_size" else value
+                   for name, value in ((name, getattr(self, name)) for name in SETTINGS)}
+        given = {name: value for name, value in current.items()
+                 if value != defaults[name] or parser.parse_arg(f"env.{name}", args) is not None}
+        settings, warnings = match_settings(checkpoint, given, defaults, spell=lambda name: f"--env.{name}")
+        log = logging.getLogger(__name__)
+        for warning in warnings:
+            log.warning("tavis: %s", warning)
+        taken = {name: value for name, value in settings.items() if name not in given and value != current[name]}
+        if taken:
+            log.info("tavis: the env takes the checkpoint's %s",
+                     ", ".join(f"{name} {'x'.join(map(str, value)) if name == 'image_size' else value}"
+                               for name, value in taken.items()))
+        self.robot, self.camera_mode, self.image_size = (settings[name] for name in SETTINGS)
+        self._derive_features()
+
     def create_envs(self, n_envs: int, use_async_envs: bool = False) -> dict[str, dict[int, gym.vector.VectorEnv]]:
+        self.match_command_line_policy()
         envs: dict[str, dict[int, gym.vector.VectorEnv]] = {}
         for suite, factories in self.sub_env_factories().items():
             envs[suite] = {}

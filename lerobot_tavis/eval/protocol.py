@@ -14,14 +14,17 @@ One run at a time writes an output directory (`locking`).
 from __future__ import annotations
 
 import json
+import logging
 import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis import checks
-from lerobot_tavis.cli_options import option
+from lerobot_tavis.cli_options import option, spelling
 from lerobot_tavis.dataset_tools.workers import BACKENDS
+from lerobot_tavis.envs.checkpoint_settings import (CheckpointSettings, match_settings, pretrained_model_dir,
+                                                    read_checkpoint_settings)
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, RENAMED_MODES, camera_mode_names, resolve_camera_mode
 from lerobot_tavis.envs.physics import POLICY_HZ
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
@@ -68,10 +71,13 @@ ENV_DEFAULTS = {"robot": DEFAULT_ROBOT, "camera_mode": DEFAULT_CAMERA_MODE, "ima
 @dataclass(frozen=True, kw_only=True)
 class ProtocolConfig:
     """The protocol run of `tavis eval`; also its command-line options. Exactly one of `policy_path` and `expert`;
-    `robot`, `camera_mode` and `image_size` left None are the checkpoint's, else ENV_DEFAULTS; `suites` left None
-    are those of `tasks`, else the first of SUITES."""
+    `robot`, `camera_mode` and `image_size` left None are the checkpoint's, else ENV_DEFAULTS, and a given one that
+    differs from the checkpoint's is logged as a warning (`checkpoint_settings.match_settings`); `image_size` is
+    refused with `expert` (the demonstrators render nothing); `suites` left None are those of `tasks`, else the
+    first of SUITES."""
 
-    policy_path: str | None = option(None, "policy checkpoint directory (pretrained_model)", flag="--policy")
+    policy_path: str | None = option(None, "policy checkpoint directory (pretrained_model) or Hub repo id (default: "
+                                     "none, give this or --expert)", flag="--policy")
     expert: bool = option(False, "evaluate the scripted demonstrators instead")
     robot: str | None = option(None, f"default: the checkpoint's, else {DEFAULT_ROBOT}", choices=robot_names)
     suites: tuple[str, ...] | None = option(None, f"default: the suites of --tasks, else {SUITES[0]}", flag="--suite",
@@ -85,13 +91,15 @@ class ProtocolConfig:
     camera_mode: str | None = option(None, "default: the checkpoint's, else head_wrist; head_wrist and fixed_wrist "
                                      "are the paper's headcam and fixedcam conditions",
                                      choices=lambda: [*camera_mode_names(), *RENAMED_MODES])
-    image_size: tuple[int, int] | None = option(None, "HxW; default: the checkpoint's, else 480x640",
+    image_size: tuple[int, int] | None = option(None, "HxW of the policy's camera images (default: the checkpoint's, "
+                                                "else 480x640; refused with --expert)",
                                                 parse=checks.image_size_text)
     batch_size: int = option(1, "parallel envs per task (policy runs)")
     device: str = "cpu"
     episode_length_s: float = option(20.0, "seconds per episode (default 20)")
     policy_options: tuple[tuple[str, object], ...] = option(  # (field, value) set on the checkpoint's policy config
-        (), "set a field of the checkpoint's policy config, e.g. num_inference_steps=10 or use_amp=true (repeatable)",
+        (), "set a field of the checkpoint's policy config, e.g. num_inference_steps=10 or use_amp=true (repeatable; "
+        "default: none)",
         flag="--policy-option", action="append", metavar="FIELD=VALUE", parse=policy_options)
     workers: int = option(1, "(cell, task, seed chunk) jobs at once; with a policy on a GPU they share it")
     chunk_episodes: int | None = option(None, "consecutive episodes per job, also what a killed run loses at most "
@@ -111,11 +119,19 @@ class ProtocolConfig:
         if bool(self.policy_path) == self.expert:
             raise InputError("give exactly one of --policy PATH and --expert")
         object.__setattr__(self, "policy_path", self.policy_path or None)
-        trained = _trained_env(self.policy_path) if self.policy_path else {}
-        for name, default in ENV_DEFAULTS.items():
-            if getattr(self, name) is None:
-                object.__setattr__(self, name, trained.get(name, default))
-        object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
+        if self.image_size is not None and checks.image_size(self.image_size) and self.expert:
+            raise FieldError("image_size", "does not apply to --expert: the demonstrators act on the simulator state "
+                                           "and render nothing")
+        if self.camera_mode is not None:
+            object.__setattr__(self, "camera_mode", resolve_camera_mode(self.camera_mode))
+        given = {name: getattr(self, name) for name in ENV_DEFAULTS if getattr(self, name) is not None}
+        checkpoint = _checkpoint_settings(self.policy_path) if self.policy_path else CheckpointSettings()
+        settings, warnings = match_settings(checkpoint, given, ENV_DEFAULTS,
+                                            spell=lambda name: spelling(ProtocolConfig, name))
+        for warning in warnings:
+            logging.getLogger(__name__).warning("tavis eval: warning: %s", warning)
+        for name, value in settings.items():
+            object.__setattr__(self, name, value)
         if self.suites is None:
             object.__setattr__(self, "suites", tuple(dict.fromkeys(task_info(task).suite for task in self.tasks))
                                or SUITES[:1])
@@ -148,33 +164,17 @@ class ProtocolConfig:
         return 1.0 / self.workers if self.policy_path is not None and self.device.startswith("cuda") else 0.0
 
 
-def checkpoint_env(policy_path: str | Path) -> dict:
-    """The tavis env settings a checkpoint was trained with (robot, camera_mode, image_size), read from the
-    `train_config.json` lerobot-train saves beside it; empty when there is none or it is not a tavis run."""
-    path = Path(policy_path) / "train_config.json"
-    if not path.is_file():
-        return {}
-    try:
-        env = json.loads(path.read_text()).get("env") or {}
-    except json.JSONDecodeError as error:
-        raise InputError(f"{path}: not a JSON file ({error.msg})") from None
-    if env.get("type") != "tavis":
-        return {}
-    found = {key: env[key] for key in ("robot", "camera_mode", "image_size") if key in env}
-    if "image_size" in found:
-        found["image_size"] = tuple(found["image_size"])
-    return found
-
-
-def _trained_env(policy_path: str) -> dict:
-    """`checkpoint_env` of a local checkpoint, nothing for a Hub repo id; a path that is neither is refused."""
+def _checkpoint_settings(policy_path: str) -> CheckpointSettings:
+    """What the checkpoint says of its env: a local checkpoint's (a folder without config.json is refused, naming
+    the checkpoint below it), a Hub repo's (its config files downloaded, as the run would); a path that is neither
+    is refused."""
     if Path(policy_path).exists():
-        return checkpoint_env(policy_path)
+        return read_checkpoint_settings(pretrained_model_dir(policy_path))
     try:
         checks.repo_id(policy_path)
     except FieldError:
         raise FieldError("policy_path", f"{policy_path}: no such checkpoint directory") from None
-    return {}
+    return read_checkpoint_settings(policy_path, download=True)
 
 
 def run_protocol(cfg: ProtocolConfig) -> list[Path]:

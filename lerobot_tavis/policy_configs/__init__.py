@@ -27,6 +27,9 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
   every 800: the recipe of the trained baselines (docs/results/README.md); `--policy.time_input=false` suits a head +
   wrists policy alone better.
 
+`tavis train` checks a local dataset against the preset first (`check_training_dataset`): the cameras the policy
+reads must be there and, for ACT (which does not resize its images), at the preset's size.
+
 The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
 keeps the two in step.
 """
@@ -34,12 +37,14 @@ keeps the two in step.
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from pathlib import Path
 
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.modes import (BUILTIN_CAMERA_MODES, RENAMED_MODES, mode_cameras, neck_locked,
                                       resolve_camera_mode)
 from lerobot_tavis.errors import InputError
+from lerobot_tavis.policies.dataset_fit import UNRESIZED_POLICIES, check_dataset_images
 
 PRESET_DIR = Path(__file__).parent
 POLICIES = ("diffusion", "pi0")
@@ -152,6 +157,26 @@ def write_presets() -> list[Path]:
         path.write_text(json.dumps(build_preset(policy, mode, compact), indent=2) + "\n")
         written.append(path)
     return written
+
+
+def check_training_dataset(preset: Path, lerobot_args: Sequence[str]) -> None:
+    """Refuse (InputError, `policies.dataset_fit`) a training dataset that lacks a camera the preset's policy reads
+    or, for a policy that does not resize its images (ACT), holds them at another size than the preset's. The
+    dataset is `--dataset.root` of `lerobot_args`, else the preset's, else LeRobot's local copy of
+    `--dataset.repo_id`; a dataset not on this machine is not checked (lerobot-train downloads it)."""
+    from lerobot.configs.parser import parse_arg
+    from lerobot.utils.constants import HF_LEROBOT_HOME
+
+    config = json.loads(preset.read_text())
+    dataset = config.get("dataset", {})
+    root = parse_arg("dataset.root", lerobot_args) or dataset.get("root")
+    repo_id = parse_arg("dataset.repo_id", lerobot_args) or dataset.get("repo_id")
+    info = Path(root) / "meta" / "info.json" if root else HF_LEROBOT_HOME / str(repo_id) / "meta" / "info.json"
+    if not info.is_file():
+        return
+    policy_type = parse_arg("policy.type", lerobot_args) or config["policy"]["type"]
+    check_dataset_images(config["policy"].get("input_features", {}), json.loads(info.read_text())["features"],
+                         resizes=policy_type not in UNRESIZED_POLICIES)
 
 
 def missing_pi0_downloads() -> list[str]:

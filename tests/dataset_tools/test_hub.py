@@ -2,6 +2,7 @@
 successful push runs against fakes of the huggingface_hub calls that upload."""
 
 import socket
+from pathlib import Path
 
 import httpx
 import numpy as np
@@ -197,3 +198,114 @@ def test_pull_of_a_missing_repo(hub, tmp_path, monkeypatch):
 def test_pull_of_a_local_copy_needs_no_hub(dataset_root, hub):
     dataset = pull_dataset(REPO_ID, root=dataset_root)
     assert dataset.meta.total_episodes == 3 and dataset.repo_id == REPO_ID
+
+
+# A policy checkpoint: `tavis push-policy`. The checkpoint is its files as lerobot-train writes them (the weights
+# file's content is not read).
+POLICY_REPO = "someone/act_conditional_pick"
+TRAIN_CONFIG = {"dataset": {"repo_id": "someone/tavis-head-gr1t2", "root": "/data/tavis"}, "steps": 3200,
+                "batch_size": 128, "seed": 1000,
+                "env": {"type": "tavis", "task": "conditional_pick", "robot": "gr1t2", "camera_mode": "head_wrist",
+                        "image_size": [120, 160]},
+                "policy": {"type": "act_hand_relative"}}
+RESULTS = {"cells": [{"task": "conditional_pick", "suite": "tavis_head", "split": "id", "n": 96, "successes": 39,
+                      "success_rate": 0.40625, "ci_low": 0.3132, "ci_high": 0.5064, "galt_median_s": 0.8}],
+           "sources": [{"source": "eval", "robots": ["gr1t2"], "camera_modes": ["head_wrist"]}]}
+
+
+@pytest.fixture
+def checkpoint(tmp_path):
+    """<train output>/checkpoints/003200/pretrained_model: configs, weights, a processor file."""
+    import json
+
+    folder = tmp_path / "train" / "checkpoints" / "003200" / "pretrained_model"
+    folder.mkdir(parents=True)
+    images = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, 120, 160]}
+              for camera in ("head", "left_wrist", "right_wrist")}
+    (folder / "config.json").write_text(json.dumps({"type": "act_hand_relative", "input_features": images}))
+    (folder / "train_config.json").write_text(json.dumps(TRAIN_CONFIG))
+    (folder / "model.safetensors").write_bytes(b"weights")
+    (folder / "policy_preprocessor.json").write_text("{}")
+    (tmp_path / "results.json").write_text(json.dumps(RESULTS))
+    return folder
+
+
+def test_policy_card_names_env_robot_task_cameras_data_recipe_commands_and_results(checkpoint):
+    from lerobot_tavis.policies.hub import policy_card
+
+    card = policy_card(checkpoint, POLICY_REPO, RESULTS)
+    front_matter = card.split("---\n")[1]
+    assert "library_name: lerobot" in front_matter and "- someone/tavis-head-gr1t2" in front_matter
+    assert all(f"- {tag}\n" in front_matter for tag in ("lerobot", "tavis", "robotics", "act_hand_relative"))
+    for text in ("| Policy | LeRobot `act_hand_relative` |", "`--env.type=tavis`", "| Task | `conditional_pick` |",
+                 "| Robot | `gr1t2` |", "| Camera mode | `head_wrist` |",
+                 "| Cameras read | `head`, `left_wrist`, `right_wrist` |", "| Image size | 120x160 (height x width) |",
+                 "[`someone/tavis-head-gr1t2`](https://huggingface.co/datasets/someone/tavis-head-gr1t2)",
+                 "| Recipe | preset `act_hand_relative_head_wrist_compact`; steps 3200, batch size 128, seed 1000 |",
+                 f"lerobot-eval --policy.path={POLICY_REPO} --env.type=tavis --env.task=conditional_pick "
+                 "--eval.n_episodes=96 --output_dir=outputs/eval/act_conditional_pick",
+                 f"tavis eval --policy {POLICY_REPO} --tasks conditional_pick",
+                 "lerobot-train --config_path=$(tavis presets act_hand_relative_head_wrist_compact) "
+                 "--dataset.repo_id=someone/tavis-head-gr1t2 --env.task=conditional_pick --steps=3200 "
+                 "--batch_size=128 --seed=1000",
+                 "on gr1t2 with camera mode head_wrist",
+                 "| `conditional_pick` | id | 96 | 40.6% | [31.3, 50.6] | 0.80 |",
+                 "@misc{tavis,"):
+        assert text in card, text
+    assert "/data/tavis" not in card  # the machine's path stays private
+    assert "## Results" not in policy_card(checkpoint, POLICY_REPO)
+
+
+def test_push_policy_uploads_the_checkpoint_card_and_results_in_one_commit(checkpoint, hub, uploads, monkeypatch):
+    from huggingface_hub import HfApi
+
+    from lerobot_tavis.policies.hub import policy_card, push_policy
+
+    staged = {}
+
+    def upload_folder(self, *, folder_path, **kwargs):  # the staging folder is gone once the push returns
+        staged.update({path.name: path.read_bytes() for path in Path(folder_path).iterdir()})
+        uploads.append(("upload_folder", kwargs))
+
+    monkeypatch.setattr(HfApi, "upload_folder", upload_folder)
+    monkeypatch.setenv("HF_TOKEN", "hf_test")
+    results = checkpoint.parents[2].parent / "results.json"
+    url = push_policy(checkpoint, POLICY_REPO, results=results, private=True)
+    assert url == f"{hub}/{POLICY_REPO}"
+    assert [name for name, _ in uploads] == ["create_repo", "upload_folder"]
+    calls = dict(uploads)
+    assert calls["create_repo"]["repo_type"] == "model" and calls["create_repo"]["private"] is True
+    assert calls["upload_folder"]["repo_type"] == "model" and calls["upload_folder"]["revision"] is None
+    assert sorted(staged) == ["README.md", "config.json", "model.safetensors", "policy_preprocessor.json",
+                              "results.json", "train_config.json"]
+    assert staged["README.md"].decode() == policy_card(checkpoint, POLICY_REPO, RESULTS)
+    assert staged["model.safetensors"] == b"weights" and staged["results.json"] == results.read_bytes()
+    assert not (checkpoint / "README.md").exists()  # the checkpoint folder is left as it was
+
+
+def test_push_policy_refuses_before_uploading(checkpoint, hub, uploads, monkeypatch, tmp_path):
+    from lerobot_tavis.policies.hub import push_policy
+
+    with pytest.raises(HubError, match="not logged in"):
+        push_policy(checkpoint, POLICY_REPO)
+    monkeypatch.setenv("HF_TOKEN", "hf_test")
+    train = checkpoint.parents[2]
+    with pytest.raises(FileNotFoundError, match=f"{train} holds no config.json: pass {checkpoint}$"):
+        push_policy(train, POLICY_REPO)
+    (tmp_path / "other.json").write_text('{"per_task": []}')
+    with pytest.raises(ValueError, match="other.json: not a `tavis report` results.json"):
+        push_policy(checkpoint, POLICY_REPO, results=tmp_path / "other.json")
+    (checkpoint / "model.safetensors").unlink()
+    with pytest.raises(FileNotFoundError, match="holds no model.safetensors"):
+        push_policy(checkpoint, POLICY_REPO)
+    assert uploads == []
+
+
+def test_tavis_push_policy_prints_the_models_url(checkpoint, hub, uploads, monkeypatch, capsys):
+    from lerobot_tavis.cli import main
+
+    monkeypatch.setenv("HF_TOKEN", "hf_test")
+    main(["push-policy", str(checkpoint), "--repo-id", POLICY_REPO, "--branch", "step/3200"])
+    assert capsys.readouterr().out.strip() == f"{hub}/{POLICY_REPO}/tree/step%2F3200"
+    calls = dict(uploads)
+    assert calls["create_branch"]["branch"] == "step/3200" and calls["upload_folder"]["revision"] == "step/3200"

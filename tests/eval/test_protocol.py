@@ -21,7 +21,7 @@ from lerobot_tavis.eval.run_identity import run_identity
 
 def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
     cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",),
-                         n_episodes=2, image_size=(24, 32), workers=1)
+                         n_episodes=2, workers=1)
     written = {p.name for p in run_protocol(cfg)}
     assert {"results.md", "results.json", "success_rates.png"} <= written
     cell = tmp_path / "tavis_hands__id"
@@ -43,7 +43,7 @@ def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
 
 def test_tasks_play_only_those_tasks_and_a_cell_of_other_tasks_is_not_reused(tmp_path):
     cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", splits=("id",), tasks=("occluded_reach",),
-                         n_episodes=2, image_size=(24, 32))
+                         n_episodes=2)
     assert cfg.suites == ("tavis_hands",)  # the task's suite
     run_protocol(cfg)
     assert [path.name for path in tmp_path.glob("*__*")] == ["tavis_hands__id"]
@@ -54,7 +54,7 @@ def test_tasks_play_only_those_tasks_and_a_cell_of_other_tasks_is_not_reused(tmp
     assert [(r["task"], r["seed"]) for r in records] == [("occluded_reach", 1000), ("occluded_reach", 1001)]
     with pytest.raises(InputError, match="holds the tasks \\['occluded_reach'\\], not those asked for"):
         run_protocol(ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",),
-                                    splits=("id",), n_episodes=2, image_size=(24, 32)))
+                                    splits=("id",), n_episodes=2))
 
 
 def test_a_task_outside_the_suites_is_refused(tmp_path):
@@ -68,8 +68,7 @@ def _cell_files(root, cell="tavis_hands__id"):
 
 def test_expert_results_do_not_depend_on_workers_or_chunking(tmp_path):
     """Chunks of one seed finish in any order over 2 workers; the cell is the same as one process playing all."""
-    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2,
-                  image_size=(24, 32))
+    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2)
     run_protocol(ProtocolConfig(out_dir=tmp_path / "one", workers=1, **common))
     run_protocol(ProtocolConfig(out_dir=tmp_path / "two", workers=2, chunk_episodes=1, **common))
     assert _cell_files(tmp_path / "one") == _cell_files(tmp_path / "two")
@@ -79,7 +78,7 @@ def test_expert_results_do_not_depend_on_workers_or_chunking(tmp_path):
 def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     """A chunk whose `done` record exists is not played again: its stored outcome is what the cell reports."""
     cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",),
-                         n_episodes=1, image_size=(24, 32), chunk_episodes=1)
+                         n_episodes=1, chunk_episodes=1)
     work = tmp_path / ".tavis_hands__id.chunks"
     work.mkdir(parents=True)
     (work / "run.json").write_text(json.dumps(run_identity(cfg)))  # what the killed run wrote when it began
@@ -97,25 +96,89 @@ def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     assert records[1]["prompt"] != "stored" and not work.exists()
 
 
-def _trained_checkpoint(path, env):
+def _trained_checkpoint(path, env, cameras=None, image_size=(120, 160)):
+    """A checkpoint's two config files (no weights): its policy reads `cameras` at `image_size`, its training ran
+    with the env `env`."""
     path.mkdir(parents=True)
+    images = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, *image_size]} for camera in cameras or ()}
+    (path / "config.json").write_text(json.dumps({"type": "diffusion", "input_features": images}))
     (path / "train_config.json").write_text(json.dumps({"env": env, "policy": {"type": "diffusion"}}))
     return path
 
 
-@pytest.mark.parametrize("extra,expected", [
-    ([], ("reachy2", "fixed_wrist", (120, 160))),  # all from the checkpoint's training config
-    (["--camera-mode", "head_only", "--image-size", "96x128"], ("reachy2", "head_only", (96, 128))),  # given wins
+@pytest.mark.parametrize("extra,expected,warned", [
+    ([], ("reachy2", "fixed_wrist", (120, 160)), []),  # all from the checkpoint's training config
+    (["--camera-mode", "head_only", "--image-size", "96x128"], ("reachy2", "head_only", (96, 128)),  # given wins,
+     ["trained with camera mode fixed_wrist; --camera-mode asks for head_only",  # with a warning for each
+      "trained on 120x160 images; --image-size asks for 96x128 (leave --image-size out"]),
 ])
-def test_tavis_eval_takes_robot_camera_mode_and_image_size_from_the_checkpoint(tmp_path, monkeypatch, extra,
-                                                                                expected):
+def test_tavis_eval_takes_robot_camera_mode_and_image_size_from_the_checkpoint(tmp_path, monkeypatch, caplog, extra,
+                                                                                expected, warned):
     checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {
         "type": "tavis", "robot": "reachy2", "camera_mode": "fixed_wrist", "image_size": [120, 160]})
     seen = []
     monkeypatch.setattr(protocol, "run_protocol", lambda cfg: seen.append(cfg) or [])
-    main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), *extra])
+    with caplog.at_level(logging.WARNING):
+        main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), *extra])
     (cfg,) = seen
     assert (cfg.robot, cfg.camera_mode, cfg.image_size) == expected
+    assert len(caplog.records) == len(warned)
+    assert all(text in record.getMessage() for text, record in zip(warned, caplog.records))
+
+
+def test_tavis_eval_takes_the_image_size_and_cameras_the_policy_reads(tmp_path, monkeypatch):
+    """Without a tavis training config (e.g. trained on another env's config), the policy's input features say
+    which cameras and which size it reads."""
+    checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {"type": "aloha"},
+                                     cameras=("fixed", "left_wrist", "right_wrist"), image_size=(96, 128))
+    seen = []
+    monkeypatch.setattr(protocol, "run_protocol", lambda cfg: seen.append(cfg) or [])
+    main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out")])
+    assert (seen[0].camera_mode, seen[0].image_size) == ("fixed_wrist", (96, 128))
+
+
+def test_tavis_eval_of_a_hub_policy_fetches_its_settings(tmp_path, monkeypatch):
+    """A published baseline (`--policy <user>/<name>`): its two config files come from the Hub (faked here)."""
+    import huggingface_hub
+
+    published = _trained_checkpoint(tmp_path / "hub", {"type": "tavis", "robot": "reachy2"},
+                                     cameras=("head", "left_wrist", "right_wrist"), image_size=(96, 128))
+    fetched = []
+    monkeypatch.setattr(huggingface_hub, "hf_hub_download",
+                        lambda repo_id, name: fetched.append((repo_id, name)) or str(published / name))
+    cfg = ProtocolConfig(policy_path="someone/act", out_dir=tmp_path / "out")
+    assert (cfg.robot, cfg.camera_mode, cfg.image_size) == ("reachy2", "head_wrist", (96, 128))
+    assert fetched == [("someone/act", "config.json"), ("someone/act", "train_config.json")]
+
+
+def test_tavis_eval_refuses_a_camera_mode_without_the_policys_cameras(tmp_path):
+    checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {"type": "tavis", "camera_mode": "fixed_wrist"},
+                                     cameras=("fixed", "left_wrist", "right_wrist"))
+    with pytest.raises(SystemExit, match="tavis eval: error: the policy reads the cameras fixed, left_wrist, "
+                                         "right_wrist, camera mode head_wrist renders head, left_wrist, right_wrist: "
+                                         "use --camera-mode fixed_wrist"):
+        main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), "--camera-mode", "head_wrist"])
+
+
+def test_expert_runs_refuse_an_image_size(tmp_path):
+    with pytest.raises(SystemExit, match="tavis eval: error: --image-size does not apply to --expert: the "
+                                         "demonstrators act on the simulator state and render nothing"):
+        main(["eval", "--expert", "--image-size", "96x128", "--out", str(tmp_path / "out")])
+
+
+def test_a_training_output_folder_names_its_checkpoint(tmp_path):
+    """`tavis eval --policy <lerobot-train output>`: the one-line error names the checkpoint folder to pass."""
+    train = tmp_path / "train"
+    for step in ("000800", "001600"):
+        _trained_checkpoint(train / "checkpoints" / step / "pretrained_model", {"type": "tavis"})
+    with pytest.raises(SystemExit, match=f"^tavis eval: error: {train} holds no config.json: pass "
+                                         f"{train}/checkpoints/001600/pretrained_model$"):
+        main(["eval", "--policy", str(train), "--out", str(tmp_path / "out")])
+    (train / "checkpoints" / "last").symlink_to("001600")
+    with pytest.raises(SystemExit, match=f"pass {train}/checkpoints/last/pretrained_model$"):
+        main(["eval", "--policy", str(train), "--out", str(tmp_path / "out")])
+    with pytest.raises(SystemExit, match=f"pass {train}/checkpoints/000800/pretrained_model$"):
+        main(["eval", "--policy", str(train / "checkpoints" / "000800"), "--out", str(tmp_path / "out")])
 
 
 def test_lerobot_options_pass_through_to_the_policy_and_the_env(tmp_path, monkeypatch):
@@ -284,6 +347,25 @@ def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path, envs, v
     records = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
     assert sorted(r["seed"] for r in records) == [1000, 1001]
     assert all("galt_s" in r and r["length_steps"] == 10 for r in records)
+
+
+def test_lerobot_eval_of_a_checkpoint_renders_the_size_it_was_trained_at(tmp_path, monkeypatch, caplog):
+    """The issue's case: `lerobot-eval --policy.path=<checkpoint> --env.type=tavis` without `--env.image_size`
+    renders the checkpoint's size (32x48 here), not the env's default 480x640 (LeRobot's eval_main, in this
+    process)."""
+    from lerobot.scripts import lerobot_eval
+
+    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+    monkeypatch.setattr("sys.argv", [
+        "lerobot-eval", "--env.type=tavis", "--env.task=conditional_pick", "--env.episode_length_s=0.2",
+        f"--policy.path={tmp_path / 'ckpt'}", "--policy.device=cpu", "--eval.n_episodes=1", "--eval.batch_size=1",
+        "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'out'}"])
+    monkeypatch.setenv("HF_HUB_OFFLINE", "1")
+    with caplog.at_level(logging.INFO, logger="lerobot_tavis.envs.config"):
+        lerobot_eval.eval_main()
+    assert "the env takes the checkpoint's image_size 32x48" in caplog.text
+    (record,) = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
+    assert record["length_steps"] == 4
 
 
 def test_the_eval_config_of_a_checkpoint_does_not_warn_of_random_weights(caplog):

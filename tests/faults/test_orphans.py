@@ -38,8 +38,8 @@ def _wait_for(condition, timeout_s: float) -> bool:
 COMMANDS = {
     "record": ["record", "--robot", "gr1t2", "--tasks", "conditional_pick", "--episodes-per-task", "50",
                "--workers", "2", "--out"],
-    "eval": ["eval", "--expert", "--suite", "tavis_hands", "--splits", "id", "--episodes", "50",
-             "--image-size", "24x32", "--workers", "2", "--out"],
+    "eval": ["eval", "--expert", "--suite", "tavis_hands", "--splits", "id", "--episodes", "50", "--workers", "2",
+             "--out"],
 }
 
 

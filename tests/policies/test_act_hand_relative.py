@@ -236,6 +236,26 @@ def test_the_state_as_a_network_input_or_another_action_is_refused():
         ACTHandRelativePolicy(config)
 
 
+def test_lerobot_train_refuses_a_dataset_of_another_image_size_or_without_its_cameras():
+    """lerobot-train's make_policy hands the policy config the training dataset's features: ACT would learn at the
+    dataset's size while its checkpoint claimed the config's."""
+    from lerobot.policies.factory import make_policy
+
+    def dataset(cameras, size):
+        images = {f"observation.images.{c}": {"dtype": "video", "shape": [*size, 3],
+                                                  "names": ["height", "width", "channels"]} for c in cameras}
+        vectors = {key: {"dtype": "float32", "shape": [19], "names": None} for key in (ACTION, OBS_STATE)}
+        return SimpleNamespace(features=images | vectors, stats=None)
+
+    _config().set_dataset_feature_metadata(dataset(["head", "fixed"], (32, 32)).features)  # more cameras: fine
+    with pytest.raises(ValueError, match="the dataset's head images are 24x32, the policy's input_features say "
+                                         "32x32 .*convert the dataset with --image-size 32x32"):
+        make_policy(_config(), ds_meta=dataset(["head"], (24, 32)))
+    with pytest.raises(ValueError, match="the policy reads the cameras head, the dataset has fixed: convert the "
+                                         "dataset with --cameras head"):
+        make_policy(_config(), ds_meta=dataset(["fixed"], (32, 32)))
+
+
 def test_without_the_dataset_statistics_it_refuses_to_act():
     policy = ACTHandRelativePolicy(_config())
     with pytest.raises(RuntimeError, match="act_hand_relative has no absolute_mean"):

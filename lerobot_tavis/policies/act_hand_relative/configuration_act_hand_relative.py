@@ -10,6 +10,7 @@ from lerobot.policies.act.configuration_act import ACTConfig
 from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_STATE
 
 from lerobot_tavis import canonical
+from lerobot_tavis.policies.dataset_fit import check_dataset_images
 
 AMP_DTYPES = ("bfloat16", "float16")
 
@@ -60,6 +61,11 @@ class ACTHandRelativeConfig(ACTConfig):
         if action is None or tuple(action.shape) != (canonical.ACTION_DIM,):
             raise ValueError(f"act_hand_relative needs TAVIS's {canonical.ACTION_DIM}-D canonical {ACTION}, got "
                              f"{None if action is None else tuple(action.shape)}")
+
+    def set_dataset_feature_metadata(self, dataset_features: dict) -> None:
+        """lerobot-train's hook (its `make_policy`, given the training dataset): the dataset must hold the cameras
+        the policy reads at the size its input_features say, which evaluation renders."""
+        check_dataset_images(self.input_features, dataset_features, resizes=False)
 
     def _check_amp_dtype(self) -> None:
         if self.amp_dtype not in AMP_DTYPES:
