@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import signal
 import sys
 import threading
@@ -13,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis.cli_options import CommandParser, from_args, option, spelling
-from lerobot_tavis.errors import FieldError, InputError, TavisError
+from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError
 
 
 @dataclass(frozen=True)
@@ -171,12 +172,39 @@ def _train(options: TrainOptions) -> None:
     from lerobot_tavis.policy_configs import missing_pi0_downloads, preset_path
 
     path = preset_path(options.preset)
+    _check_training_dataset(path, options.lerobot_args)
     if options.preset.startswith("pi0") and (missing := missing_pi0_downloads()):
         raise InputError(f"pi0 needs {', '.join(missing)}, which are neither in the Hugging Face cache nor "
                          "downloadable here: log in (`hf auth login`, and accept the PaliGemma licence on the Hub) "
                          "or fill HF_HOME on a machine with network access")
     command = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={path}", *options.lerobot_args]
     sys.exit(subprocess.call(command))
+
+
+def _check_training_dataset(preset: Path, lerobot_args: tuple[str, ...]) -> None:
+    """The dataset a training reads must be on disk unless it is a Hub dataset: a missing --dataset.root is one line
+    here, not lerobot-train's failed Hub download of the preset's placeholder `local/...` repo id. The root is
+    --dataset.root, else LeRobot's default `$HF_LEROBOT_HOME/<repo_id>`."""
+    import json
+
+    from huggingface_hub.constants import HF_HOME
+
+    dataset = argparse.ArgumentParser(add_help=False, allow_abbrev=False)  # LeRobot's --a.b=x and --a.b x alike
+    dataset.add_argument("--dataset.root", dest="root")
+    dataset.add_argument("--dataset.repo_id", dest="repo_id")
+    given, _ = dataset.parse_known_args(lerobot_args)
+    repo_id = given.repo_id or json.loads(preset.read_text())["dataset"]["repo_id"]
+    root = given.root
+    if root is not None:
+        if not (Path(root) / "meta" / "info.json").is_file():
+            raise PathNotFoundError(f"--dataset.root {root} holds no LeRobotDataset (no meta/info.json): pass the "
+                                    "folder `tavis convert --root` wrote")
+    elif repo_id.startswith("local/"):
+        home = Path(os.environ.get("HF_LEROBOT_HOME", Path(HF_HOME) / "lerobot")).expanduser()
+        if not (home / repo_id / "meta" / "info.json").is_file():
+            raise InputError(f"no --dataset.root: pass --dataset.root=<the folder `tavis convert --root` wrote> (the "
+                             f"dataset {repo_id} is local, not on the Hub), or --dataset.repo_id=<owner>/<name> of a "
+                             "dataset on the Hub")
 
 
 def build_parser() -> argparse.ArgumentParser:

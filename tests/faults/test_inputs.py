@@ -248,3 +248,14 @@ def test_a_checkpoint_folder_without_its_config_is_one_line(tmp_path):
     checkpoint.mkdir()
     message = _refused(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out")])
     assert message.startswith("tavis eval: error: ") and "config.json" in message and str(checkpoint) in message
+
+
+def test_a_training_without_its_dataset_is_one_line_before_lerobot_train_starts(tmp_path, monkeypatch):
+    monkeypatch.setenv("HF_LEROBOT_HOME", str(tmp_path / "cache"))  # LeRobot's default root: empty
+    assert _refused(["train", "diffusion_head_wrist", "--steps=1"]).startswith(
+        "tavis train: error: no --dataset.root: pass --dataset.root=")
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    for root in (["--dataset.root", str(empty)], [f"--dataset.root={tmp_path / 'missing'}"]):
+        assert _refused(["train", "diffusion_head_wrist", *root]).startswith(
+            f"tavis train: error: --dataset.root {root[-1].removeprefix('--dataset.root=')} holds no LeRobotDataset")
