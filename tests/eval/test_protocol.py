@@ -174,15 +174,18 @@ def _diffusion_checkpoint(path, image_size):
         processor.save_pretrained(path)
 
 
-def test_policy_protocol_runs_through_lerobot_eval(tmp_path):
+def test_policy_protocol_runs_through_lerobot_eval_under_one_progress_bar(tmp_path, capsys):
     _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
     cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("ood_init_pose",),
                          n_episodes=1, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
                          policy_options=(("num_inference_steps", 1),))
+    capsys.readouterr()
     run_protocol(cfg)
     results = json.loads((tmp_path / "eval" / "results.json").read_text())
     assert [(c["task"], c["split"], c["n"]) for c in results["cells"]] == [
         (task, "ood_init_pose", 1) for task in suite_tasks("tavis_head")]
+    bars = {line.split(":")[0] for line in re.split(r"[\r\n]+", capsys.readouterr().err) if "|" in line}
+    assert bars == {"policy"}  # the run's own bar; none of lerobot-eval's batch and rollout bars
 
 
 def _tiny_policy_cell(tmp_path, name: str, suite: str, **settings):
