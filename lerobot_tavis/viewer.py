@@ -71,6 +71,14 @@ class Window:
         self._period_s = 1.0 / rate_hz
         self._next_frame = time.perf_counter()
 
+    def overlay(self, top_left: tuple[str, str], bottom_left: tuple[str, str]) -> None:
+        """Text drawn over the scene from the next frame on: two boxes of two columns each (lines split by "\\n")."""
+        import mujoco
+
+        self._handle.set_texts([
+            (mujoco.mjtFontScale.mjFONTSCALE_150, mujoco.mjtGridPos.mjGRID_TOPLEFT, *top_left),
+            (mujoco.mjtFontScale.mjFONTSCALE_150, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, *bottom_left)])
+
     def keys(self) -> list[int]:
         pressed = []
         while not self._pressed.empty():

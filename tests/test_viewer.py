@@ -33,6 +33,7 @@ window = Window(env, camera="head")
 following = window._handle.cam.fixedcamid == env.world.cameras["head"]
 window._pressed.put(32)  # what the viewer's key callback does on SPACE
 keys = [window.keys(), window.keys()]
+window.overlay(("W / S", "hand forward / back"), ("seed", "200000"))  # what teleop draws over the scene
 window.show()
 window.close()
 print(json.dumps({"following": bool(following), "keys": keys}))
