@@ -3,6 +3,11 @@
 
 VENV := .venv
 STAMP := $(VENV)/.installed
+# `make setup CPU=1`: torch and torchvision from PyTorch's CPU-only wheel index first, so that the CUDA libraries
+# PyPI's Linux torch depends on (about 3.3 GB of .venv with triton) are never installed; the rest from PyPI.
+CPU ?= 0
+TORCH_CPU_INDEX := https://download.pytorch.org/whl/cpu
+TORCH_CPU_PACKAGES := 'torch>=2.7,<2.12' torchvision
 # python3.12 from PATH, else a pyenv-managed 3.12 (pyenv shims exist even when 3.12 is not the active version).
 PYTHON ?= $(shell for p in python3.12 $$HOME/.pyenv/versions/3.12*/bin/python3.12; do \
 	$$p -c 'import sys; assert sys.version_info[:2] == (3, 12)' 2>/dev/null && { echo $$p; break; }; done)
@@ -17,6 +22,11 @@ $(STAMP): pyproject.toml
 	@$(MAKE) --no-print-directory system-deps
 	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --upgrade pip
+ifeq ($(CPU),1)
+	$(VENV)/bin/python -m pip install --index-url $(TORCH_CPU_INDEX) $(TORCH_CPU_PACKAGES) \
+		|| { echo "CPU=1: PyTorch's CPU wheels could not be installed from $(TORCH_CPU_INDEX) (PyPI has none" \
+			"for Linux); without CPU=1, PyPI's CUDA build runs on a CPU as well"; exit 1; }
+endif
 	$(VENV)/bin/python -m pip install -e '.[dev]'
 	touch $(STAMP)
 
