@@ -1,6 +1,7 @@
 """`--env.type=tavis` as LeRobot uses it: registry, features, create_envs (sync and forkserver async), seeds."""
 
 import os
+import warnings
 from functools import partial
 from pathlib import Path
 
@@ -196,8 +197,13 @@ def test_a_retarget_that_fails_in_the_workers_raises_at_the_next_use():
         vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
         broken = partial(make_tavis_env, "conditional_pick", "gr1t2", "head_wrist", "no_split", (24, 32), 20.0)
         vec.retarget([broken] * 2, filmed_envs=0)
-        with pytest.raises(FieldError, match="split must be one of"):  # the worker's error, type and message
+        with (pytest.raises(FieldError, match="split must be one of"),  # the worker's error, type and message
+              warnings.catch_warnings(record=True) as reported):
+            warnings.simplefilter("always")
             vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+        # gymnasium also reports a worker's error, with its traceback, as warnings
+        assert "Received the following error from Worker" in str(reported[0].message)
+        assert all("ERROR" in str(warning.message) for warning in reported)
     finally:
         vec.close()
 
