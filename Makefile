@@ -3,6 +3,11 @@
 
 VENV := .venv
 STAMP := $(VENV)/.installed
+# `make setup CPU=1`: torch and torchvision from PyTorch's CPU-only wheel index first, so that the CUDA libraries
+# PyPI's Linux torch depends on (about 3.3 GB of .venv with triton) are never installed; the rest from PyPI.
+CPU ?= 0
+TORCH_CPU_INDEX := https://download.pytorch.org/whl/cpu
+TORCH_CPU_PACKAGES := 'torch>=2.7,<2.12' torchvision
 # python3.12 from PATH, else a pyenv-managed 3.12 (pyenv shims exist even when 3.12 is not the active version).
 PYTHON ?= $(shell for p in python3.12 $$HOME/.pyenv/versions/3.12*/bin/python3.12; do \
 	$$p -c 'import sys; assert sys.version_info[:2] == (3, 12)' 2>/dev/null && { echo $$p; break; }; done)
@@ -17,19 +22,29 @@ $(STAMP): pyproject.toml
 	@$(MAKE) --no-print-directory system-deps
 	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --upgrade pip
+ifeq ($(CPU),1)
+	$(VENV)/bin/python -m pip install --index-url $(TORCH_CPU_INDEX) $(TORCH_CPU_PACKAGES) \
+		|| { echo "CPU=1: PyTorch's CPU wheels could not be installed from $(TORCH_CPU_INDEX) (PyPI has none" \
+			"for Linux); without CPU=1, PyPI's CUDA build runs on a CPU as well"; exit 1; }
+endif
 	$(VENV)/bin/python -m pip install -e '.[dev]'
 	touch $(STAMP)
 
-# Headless OpenGL for MuJoCo (EGL on Mesa), and Xvfb, the virtual display the viewer's test (and `xvfb-run -a
-# tavis view` on a machine without a desktop) opens its window on. Installed only when missing and when apt-get can run.
+# Headless OpenGL for MuJoCo (EGL on Mesa); Xvfb, the virtual display the viewer's test (and `xvfb-run -a
+# tavis view` on a machine without a desktop) opens its window on; FFmpeg's shared libraries, which torchcodec (the
+# video decoder LeRobot prefers) loads at run time: without them every dataset load prints torchcodec's failure to
+# load before LeRobot falls back to PyAV. torchcodec ships builds for FFmpeg 4 to 8, so the distribution's own
+# ffmpeg package fits (Debian 12: FFmpeg 5.1, libavcodec.so.59). Installed only when missing and when apt-get can run.
+SYSTEM_PACKAGES := libegl1 libgl1-mesa-dri libopengl0 libgl1 xvfb xauth ffmpeg
 system-deps:
 	@if ldconfig -p | grep -q 'libEGL.so.1' && ldconfig -p | grep -q 'libOpenGL.so.0\|libGL.so.1' \
-		&& ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1 && command -v Xvfb >/dev/null; then :; \
+		&& ls /usr/lib/*/dri/swrast_dri.so >/dev/null 2>&1 && command -v Xvfb >/dev/null \
+		&& ldconfig -p | grep -q 'libavcodec.so.[0-9]'; then :; \
 	elif command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
-		{ apt-get update -qq && apt-get install -y -qq --no-install-recommends libegl1 libgl1-mesa-dri libopengl0 \
-			libgl1 xvfb xauth; } || echo "warning: apt-get could not install the OpenGL libraries or Xvfb"; \
-	else echo "warning: EGL/Mesa libraries or Xvfb not found (Debian: apt-get install libegl1 libgl1-mesa-dri" \
-		"libopengl0 libgl1 xvfb xauth)"; fi
+		{ apt-get update -qq && apt-get install -y -qq --no-install-recommends $(SYSTEM_PACKAGES); } \
+			|| echo "warning: apt-get could not install the OpenGL libraries, Xvfb or FFmpeg"; \
+	else echo "warning: EGL/Mesa libraries, Xvfb or FFmpeg's libraries not found (Debian: apt-get install" \
+		"$(SYSTEM_PACKAGES))"; fi
 
 demo: $(STAMP)
 	$(VENV)/bin/tavis demo --out outputs/demo

@@ -1,13 +1,19 @@
 """The plugin module LeRobot imports in every CLI: registers `--env.type=tavis` (it loads LeRobot itself), and
 `--policy.type=act_hand_relative` where LeRobot's policies are loaded already, as lerobot-train and lerobot-eval load
 them before their plugins; the robot and teleop CLIs stay without them. Elsewhere
-`lerobot_tavis.policies.register_policy_types()` registers the policy type. With `TAVIS_FRAME_CACHE=1`,
-lerobot-train (which has loaded LeRobot's dataset factory by then) reads video frames from the frame cache
-(`lerobot_tavis.dataset_tools.cached_dataset`)."""
+`lerobot_tavis.policies.register_policy_types()` registers the policy type. In these CLIs a bad `--env.*` value is one
+line instead of a traceback, and so is LeRobot's warning that torchcodec cannot load (no system FFmpeg). With
+`TAVIS_FRAME_CACHE=1`, lerobot-train (which has loaded LeRobot's dataset factory by then) reads video frames from the
+frame cache (`lerobot_tavis.dataset_tools.cached_dataset`)."""
 
 import sys
 
+from lerobot_tavis.dataset_tools.quiet import shorten_torchcodec_fallback
 from lerobot_tavis.envs.config import TavisEnvConfig
+from lerobot_tavis.lerobot_cli_errors import report_env_field_errors
+
+shorten_torchcodec_fallback()
+report_env_field_errors()
 
 if "lerobot.policies" in sys.modules:
     from lerobot_tavis.policies import register_policy_types

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import signal
 import sys
 import threading
@@ -13,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis.cli_options import CommandParser, from_args, option, spelling
-from lerobot_tavis.errors import FieldError, InputError, TavisError, surroundings_message
+from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError, surroundings_message
 from lerobot_tavis.tempdir import use_private_tempdir
 
 
@@ -197,6 +198,7 @@ def _train(options: TrainOptions) -> None:
     from lerobot_tavis.policy_configs import check_training_dataset, missing_pi0_downloads, preset_path
 
     path = preset_path(options.preset)
+    _check_dataset_root(path, options.lerobot_args)
     check_training_dataset(path, options.lerobot_args)
     if options.preset.startswith("pi0") and (missing := missing_pi0_downloads()):
         raise InputError(f"pi0 needs {', '.join(missing)}, which are neither in the Hugging Face cache nor "
@@ -206,19 +208,8 @@ def _train(options: TrainOptions) -> None:
     sys.exit(subprocess.call(command))
 
 
-def version_line() -> str:
-    """`tavis --version`: this package's version and those of the packages a bug report needs, read from their
-    installed metadata (nothing is imported)."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    def installed(name: str) -> str:
-        try:
-            return version(name)
-        except PackageNotFoundError:
-            return "not installed"
-
-    others = ", ".join(f"{name} {installed(name)}" for name in ("lerobot", "mujoco", "torch"))
-    return f"tavis (lerobot_env_tavis) {installed('lerobot_env_tavis')}; {others}"
+from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError, surroundings_message
+from lerobot_tavis.tempdir import use_private_tempdir
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -13,6 +13,9 @@ import numpy as np
 from lerobot_tavis.atomic import atomic_path, write_bytes
 from lerobot_tavis.errors import InputError
 
+LABEL_MIN_SCALE, LABEL_MAX_SCALE = 0.5, 1.0  # OpenCV font scales of `label`'s text
+LABEL_BOX_OPACITY = 0.65  # how much of the image under a label's box is darkened
+
 
 def encode_mp4(frames: Iterable[np.ndarray], fps: int) -> bytes:
     """H.264 MP4 of RGB uint8 frames (H, W, 3; H and W even), encoded as they come: an iterator of frames is never
@@ -68,10 +71,15 @@ def write_png(path: str | Path, rgb: np.ndarray) -> Path:
 
 
 def label(image: np.ndarray, text: str) -> np.ndarray:
-    """A copy of `image` with `text` in its top-left corner."""
+    """A copy of `image` with `text` in white on a dark box in its top-left corner, its size following the image's
+    height (at least LABEL_MIN_SCALE, legible on a 120-pixel tile)."""
     out = image.copy()
-    scale = max(0.4, image.shape[0] / 600)
-    cv2.putText(out, text, (8, int(22 * scale)), cv2.FONT_HERSHEY_SIMPLEX, scale, (0, 0, 0), 3, cv2.LINE_AA)
-    cv2.putText(out, text, (8, int(22 * scale)), cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), 1, cv2.LINE_AA)
+    scale = min(LABEL_MAX_SCALE, max(LABEL_MIN_SCALE, image.shape[0] / 400))
+    thickness = 1 if scale < 0.7 else 2
+    (text_w, text_h), baseline = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, thickness)
+    pad = max(3, int(6 * scale))
+    box = out[:text_h + baseline + 2 * pad, :text_w + 2 * pad]
+    box[:] = (box * (1 - LABEL_BOX_OPACITY)).astype(np.uint8)  # the view stays visible through the box
+    cv2.putText(out, text, (pad, pad + text_h), cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), thickness,
+                cv2.LINE_AA)
     return out
-

@@ -1,14 +1,16 @@
 """Annotated video frames for people: a third-person overview beside the policy's own views, and a caption band
 with the prompt, the clock, success and the gaze and hand events GALT found.
 
-    +-------------------+---------+---------+
-    |                   | head    | left    |     overview (h x w) | the policy's views, half size, 2 per row
-    |     overview      +---------+---------+
-    |                   | right   |         |
-    +-------------------+---------+---------+
-    | prompt                       t 3.25 s |     caption band: prompt, clock, SUCCESS once it happened
-    | |--gaze---reach----grasp--|--------->  |     timeline of the episode with its events and the cursor
-    +----------------------------------------+
+    +-------------------+------+        +-------------------+---------+---------+
+    |                   | head |        |                   | head    | fixed   |
+    |     overview      +------+        |     overview      +---------+---------+
+    |                   | left |        |                   | left    | right   |
+    |                   +------+        +-------------------+---------+---------+
+    |                   | right|        four views: half size, two per row; one view: the overview's size;
+    +-------------------+------+        two or three: one column, so that no tile is left empty
+    | prompt, wrapped to two lines       t 3.25 s |     caption band: prompt, clock, SUCCESS once it happened
+    | |--gaze---reach----grasp--|--------->        |     timeline of the episode with its events and the cursor
+    +---------------------------------------------+
 
 Live frames (the env's `render()`, which lerobot-eval films) know only what has happened so far: the clock and
 success. Once an episode is over its events are known (`EpisodeEvents`) and `redraw_caption` rewrites the band of
@@ -28,7 +30,10 @@ from lerobot_tavis.metrics.galt import GaltResult
 
 PANEL_HEIGHT = 360  # composed panels are this many pixels high whatever the cameras' size: the text stays legible,
 # and a filmed frame stays about 1 MB (lerobot-eval holds every frame of its filmed episodes in memory)
-BAND_HEIGHT_PER_WIDTH = 0.11  # the caption band's height, relative to the frame's width
+PROMPT_LINES = 2  # the band holds this many lines of prompt; a longer prompt is drawn smaller to fit them
+FONT = cv2.FONT_HERSHEY_SIMPLEX
+# caption band rows, in pixels at text scale 1: top margin, each prompt line, the timeline, the legend, bottom margin
+BAND_TOP, BAND_LINE, BAND_TIMELINE, BAND_LEGEND, BAND_BOTTOM = 8, 30, 32, 28, 8
 WHITE, GREY, GREEN, BLACK = (255, 255, 255), (150, 150, 150), (60, 200, 90), (20, 20, 20)
 EVENT_COLOURS = {"gaze": (80, 170, 255), "reach": (255, 170, 60), "grasp": (240, 80, 80), "success": GREEN}
 
@@ -84,14 +89,26 @@ def compose(views: dict[str, np.ndarray], overview: np.ndarray, caption: Caption
 
 
 def panel_size(overview_hw: tuple[int, int]) -> tuple[int, int]:
-    """(height, width) in pixels of the overview's block (and of the views' block beside it): PANEL_HEIGHT high,
-    the overview's aspect ratio, width even."""
+    """(height, width) in pixels of the overview's block: PANEL_HEIGHT high, the overview's aspect ratio, width
+    even."""
     return PANEL_HEIGHT, 2 * round(overview_hw[1] * PANEL_HEIGHT / overview_hw[0] / 2)
 
 
+def grid_shape(n_views: int) -> tuple[int, int]:
+    """(rows, columns) of the views' grid: 2x2 for four views, else one column (one view fills the block)."""
+    return (2, 2) if n_views == 4 else (n_views, 1)
+
+
+def text_scale(frame_width: int) -> float:
+    """OpenCV font scale of the caption band's text in a frame `frame_width` pixels wide."""
+    return max(0.5, frame_width / 1400)
+
+
 def band_height(frame_width: int) -> int:
-    """Height of the caption band of a frame `frame_width` pixels wide (even)."""
-    return 2 * int(round(frame_width * BAND_HEIGHT_PER_WIDTH / 2))
+    """Height in pixels of the caption band of a frame `frame_width` pixels wide (even): PROMPT_LINES lines of
+    prompt, the timeline and its legend."""
+    rows = BAND_TOP + PROMPT_LINES * BAND_LINE + BAND_TIMELINE + BAND_LEGEND + BAND_BOTTOM
+    return 2 * int(np.ceil(rows * text_scale(frame_width) / 2))
 
 
 def redraw_caption(frame: np.ndarray, caption: Caption) -> np.ndarray:
@@ -104,63 +121,94 @@ def redraw_caption(frame: np.ndarray, caption: Caption) -> np.ndarray:
 
 
 def _view_grid(views: dict[str, np.ndarray], height: int, width: int) -> np.ndarray:
-    """The views at half size, two per row, in an (height, width) block; one view fills the block."""
-    if len(views) == 1:
-        (name, image), = views.items()
-        return label(cv2.resize(image, (width, height), interpolation=cv2.INTER_LINEAR), name)
-    cell_h, cell_w = height // 2, width // 2
-    grid = np.zeros((height, width, 3), np.uint8)
+    """The views, labelled, in a block `height` pixels high laid out by `grid_shape`, each cell of the overview's
+    aspect ratio (`width` / `height`); at most four views."""
+    rows, cols = grid_shape(len(views))
+    cell_h = height // rows
+    cell_w = 2 * round(width * cell_h / height / 2)
+    grid = np.zeros((height, cols * cell_w, 3), np.uint8)
     for index, (name, image) in enumerate(list(views.items())[:4]):
-        row, col = divmod(index, 2)
+        row, col = divmod(index, cols)
         cell = cv2.resize(image, (cell_w, cell_h), interpolation=cv2.INTER_LINEAR)
         grid[row * cell_h:(row + 1) * cell_h, col * cell_w:(col + 1) * cell_w] = label(cell, name)
     return grid
 
 
 def _draw_band(band: np.ndarray, caption: Caption) -> None:
-    """Prompt and clock on the first line, SUCCESS when reached, the timeline with its events below (in place)."""
+    """The prompt wrapped on PROMPT_LINES lines with the clock (and SUCCESS when reached) at the right of the first,
+    then the timeline with its events and their legend (in place)."""
     height, width = band.shape[:2]
-    scale = height / 110
-    thickness = max(1, int(round(scale * 1.5)))
-    margin = int(12 * scale) + 4
-    line_y = int(height * 0.30)
+    scale = text_scale(width)
+    thickness = max(1, int(round(scale * 1.6)))
+    margin = int(10 * scale) + 4
     clock = f"t {caption.time_s:5.2f} s"
-    (clock_w, _), _ = cv2.getTextSize(clock, cv2.FONT_HERSHEY_SIMPLEX, 0.6 * scale, thickness)
+    clock_w = _text_width(clock, scale, thickness)
     succeeded = caption.events.success is not None and caption.time_s >= caption.events.success
     badge = "SUCCESS" if succeeded else ""
-    (badge_w, _), _ = cv2.getTextSize(badge or " ", cv2.FONT_HERSHEY_SIMPLEX, 0.6 * scale, thickness + 1)
-    prompt_room = width - 3 * margin - clock_w - (badge_w + margin if badge else 0)
-    _put(band, _fit(caption.prompt, prompt_room, 0.6 * scale, thickness), (margin, line_y), 0.6 * scale, WHITE,
-         thickness)
-    _put(band, clock, (width - margin - clock_w, line_y), 0.6 * scale, WHITE, thickness)
+    badge_w = _text_width(badge, scale, thickness + 1) + margin if badge else 0
+    first_y = int((BAND_TOP + BAND_LINE - 8) * scale)
+    prompt_scale, lines = wrap(caption.prompt, width - 3 * margin - clock_w - badge_w, scale, thickness, PROMPT_LINES)
+    for index, line in enumerate(lines):
+        _put(band, line, (margin, first_y + int(index * BAND_LINE * scale)), prompt_scale, WHITE, thickness)
+    _put(band, clock, (width - margin - clock_w, first_y), scale, WHITE, thickness)
     if badge:
-        _put(band, badge, (width - 2 * margin - clock_w - badge_w, line_y), 0.6 * scale, GREEN, thickness + 1)
+        _put(band, badge, (width - margin - clock_w - badge_w, first_y), scale, GREEN, thickness + 1)
 
-    left, right, bar_y = margin, width - margin, int(height * 0.55)
+    left, right = margin, width - margin
+    bar_y = int((BAND_TOP + PROMPT_LINES * BAND_LINE + BAND_TIMELINE / 2) * scale)
     duration = max(caption.duration_s, 1e-6)
     to_x = lambda t: int(round(left + (right - left) * min(max(t / duration, 0.0), 1.0)))  # noqa: E731
     cv2.line(band, (left, bar_y), (right, bar_y), GREY, thickness, cv2.LINE_AA)
     cv2.line(band, (left, bar_y), (to_x(caption.time_s), bar_y), WHITE, thickness + 1, cv2.LINE_AA)
-    tick = int(height * 0.12)
-    legend_x, legend_y = left, bar_y + tick + int(16 * scale)
+    tick = int(BAND_TIMELINE * scale * 0.35)
+    legend_x, legend_y = left, int((BAND_TOP + PROMPT_LINES * BAND_LINE + BAND_TIMELINE + BAND_LEGEND - 8) * scale)
     for name, time_s in caption.events.items():
         x = to_x(time_s)
         colour = EVENT_COLOURS[name]
         cv2.line(band, (x, bar_y - tick), (x, bar_y + tick), colour, thickness + 1, cv2.LINE_AA)
         entry = f"{name} {time_s:.2f} s"
-        _put(band, entry, (legend_x, legend_y), 0.45 * scale, colour, thickness)
-        legend_x += cv2.getTextSize(entry + "   ", cv2.FONT_HERSHEY_SIMPLEX, 0.45 * scale, thickness)[0][0]
+        _put(band, entry, (legend_x, legend_y), 0.8 * scale, colour, thickness)
+        legend_x += _text_width(entry + "   ", 0.8 * scale, thickness)
     cv2.circle(band, (to_x(caption.time_s), bar_y), max(3, tick // 2), WHITE, -1, cv2.LINE_AA)
 
 
+def wrap(text: str, room: int, scale: float, thickness: int, max_lines: int) -> tuple[float, list[str]]:
+    """(font scale, lines): `text` broken at spaces into at most `max_lines` lines of at most `room` pixels, at
+    `scale` or, for a longer text, the largest smaller scale down to half of it that fits; below that, the last line
+    ends with "..." where the text is cut."""
+    for step in range(6):
+        size = scale * (1 - 0.1 * step)
+        lines = _break_lines(text, room, size, thickness)
+        if len(lines) <= max_lines:
+            return size, lines
+    kept = lines[:max_lines]
+    kept[-1] = _fit(" ".join([kept[-1], *lines[max_lines:]]), room, size, thickness)
+    return size, kept
+
+
+def _break_lines(text: str, room: int, scale: float, thickness: int) -> list[str]:
+    """`text` broken at spaces into lines of at most `room` pixels (a word wider than that has a line of its own)."""
+    lines: list[str] = []
+    for word in text.split():
+        if lines and _text_width(f"{lines[-1]} {word}", scale, thickness) <= room:
+            lines[-1] = f"{lines[-1]} {word}"
+        else:
+            lines.append(word)
+    return lines or [""]
+
+
+def _text_width(text: str, scale: float, thickness: int) -> int:
+    return cv2.getTextSize(text, FONT, scale, thickness)[0][0]
+
+
 def _put(image, text, origin, scale, colour, thickness) -> None:
-    cv2.putText(image, text, origin, cv2.FONT_HERSHEY_SIMPLEX, scale, colour, thickness, cv2.LINE_AA)
+    cv2.putText(image, text, origin, FONT, scale, colour, thickness, cv2.LINE_AA)
 
 
 def _fit(text: str, room: int, scale: float, thickness: int) -> str:
     """`text`, cut with an ellipsis to fit `room` pixels."""
-    if cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, thickness)[0][0] <= room:
+    if _text_width(text, scale, thickness) <= room:
         return text
-    while text and cv2.getTextSize(text + "...", cv2.FONT_HERSHEY_SIMPLEX, scale, thickness)[0][0] > room:
+    while text and _text_width(text + "...", scale, thickness) > room:
         text = text[:-1]
     return text + "..."

@@ -20,12 +20,14 @@ deflection; its close/open buttons drive the active gripper; its success and fai
 its re-record button drops it. The keyboard keeps the head and the hand switch.
 
 An episode also ends when the task succeeds or its time runs out, as a demonstrator's does. Seeds start at
-`--seed-start` (200000 by default, away from the demonstrators' 100000 and the evaluation's 1000).
+`--seed-start` (200000 by default, away from the demonstrators' 100000 and the evaluation's 1000). The window shows
+the key map (top left) and the episode's state (bottom left): seed, clock, active hand and gripper, episodes kept,
+and how the last episode ended; each ending is also printed as it happens, saying whether the episode was kept.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -48,6 +50,9 @@ HAND_KEYS = {ord("W"): (0, +1), ord("S"): (0, -1), ord("A"): (1, +1), ord("D"): 
 HEAD_KEYS = {KEY_UP: (canonical.HEAD_PITCH, -1), KEY_DOWN: (canonical.HEAD_PITCH, +1),
              KEY_LEFT: (canonical.HEAD_YAW, +1), KEY_RIGHT: (canonical.HEAD_YAW, -1)}  # +pitch looks down
 END, DROP = "end", "drop"
+KEY_MAP = (("W / S", "hand forward / back"), ("A / D", "hand left / right"), ("Q / E", "hand up / down"),
+           ("TAB", "switch hand"), ("SPACE", "close / open gripper"), ("arrows", "head pitch / yaw"),
+           ("0", "back to rest"), ("ENTER", "end episode"), ("BACKSPACE", "drop episode"))  # drawn in the window
 
 
 class NoGamepadError(TavisError):
@@ -143,16 +148,33 @@ class TeleopConfig:
         checks.integer("seed_start", self.seed_start, 0)
 
 
-def teleop_episode(env, seed: int, keys: Callable[[], list[int]], show: Callable[[], None], gamepad=None):
+def key_map_columns() -> tuple[str, str]:
+    """The key map as two text columns (keys, what they do), one line per key."""
+    return "\n".join(key for key, _ in KEY_MAP), "\n".join(does for _, does in KEY_MAP)
+
+
+def episode_state_columns(seed: int, time_s: float, duration_s: float, command: TeleopCommand, kept: int,
+                          wanted: int, last: str | None) -> tuple[str, str]:
+    """What the window says about the episode under way, as two text columns (labels, values)."""
+    gripper = "closed" if command.action[command.hand.gripper] > 0 else "open"
+    rows = [("seed", str(seed)), ("time", f"{time_s:4.1f} / {duration_s:.0f} s"),
+            ("hand", f"{command.hand.side}, gripper {gripper}"), ("kept", f"{kept} of {wanted}")]
+    if last:
+        rows.append(("last", last))
+    return "\n".join(label for label, _ in rows), "\n".join(value for _, value in rows)
+
+
+def teleop_episode(env, seed: int, keys: Callable[[], list[int]], show: Callable[[TeleopCommand, int], None],
+                   gamepad=None):
     """One episode of `env` (a TavisEnv at the 60 Hz record rate) driven by the key presses `keys()` returns
-    before each tick (and the `gamepad` controller, if any), `show()` after each. Returns (how it ended: END, DROP
-    or None for success or time out, success, the applied actions, the StateLog of the episode)."""
+    before each tick (and the `gamepad` controller, if any), `show(command, ticks)` after each. Returns (how it
+    ended: END, DROP or None for success or time out, success, the applied actions, the StateLog of the episode)."""
     from lerobot_tavis.dataset_tools.record import StateLog
 
     env.reset(seed=seed)
     states, command, actions = StateLog(), TeleopCommand(), []
     states.snapshot(env)
-    show()
+    show(command, 0)
     for _ in range(env._max_episode_steps):
         ending = next((result for key in keys() if (result := command.press(key))), None)
         if gamepad is not None:
@@ -162,23 +184,32 @@ def teleop_episode(env, seed: int, keys: Callable[[], list[int]], show: Callable
         _, _, terminated, truncated, info = env.step(command.action)
         actions.append(info["applied_action"])
         states.snapshot(env)
-        show()
+        show(command, len(actions))
         if terminated or truncated:
             return None, bool(info["is_success"]), actions, states
     return None, False, actions, states
 
 
+def outcome_line(seed: int, ending: str | None, success: bool, kept: bool, steps: int) -> str:
+    """How one episode ended, and whether it was kept (and why not)."""
+    if ending == DROP:
+        return f"seed {seed}: dropped"
+    why = "" if kept else "; --keep-failures keeps failed episodes"
+    return f"seed {seed}: {'success' if success else 'failure'}, {'kept' if kept else 'not kept'} ({steps} steps{why})"
+
+
 def teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None = None,
-           show: Callable[[], None] | None = None, gamepad=None) -> list[str]:
-    """Record `cfg.episodes` kept episodes into `cfg.out_dir`; returns each episode's outcome line. Without `keys`
-    and `show` it opens the viewer window, and with `cfg.gamepad` LeRobot's gamepad controller (tests pass scripted
-    key presses and controllers instead). Holds the directory's lock (`locking`), as `tavis record` does."""
+           show: Callable[[TeleopCommand, int], None] | None = None, gamepad=None) -> Iterator[str]:
+    """Record `cfg.episodes` kept episodes into `cfg.out_dir`, yielding each episode's outcome line as it ends.
+    Without `keys` and `show` it opens the viewer window, which shows the key map and the episode's state, and with
+    `cfg.gamepad` LeRobot's gamepad controller (tests pass scripted key presses and controllers instead). Holds the
+    directory's lock (`locking`), as `tavis record` does."""
     with exclusive_output(cfg.out_dir):
-        return _teleop(cfg, keys, show, gamepad)
+        yield from _teleop(cfg, keys, show, gamepad)
 
 
-def _teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None, show: Callable[[], None] | None,
-            gamepad) -> list[str]:
+def _teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None,
+            show: Callable[[TeleopCommand, int], None] | None, gamepad) -> Iterator[str]:
     from lerobot_tavis.dataset_tools.raw import ManifestEntry
     from lerobot_tavis.dataset_tools.record import RECORD_FPS, open_manifest, store_episode
     from lerobot_tavis.envs.env import TavisEnv
@@ -191,23 +222,28 @@ def _teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None, show: Calla
     env = TavisEnv(cfg.task, cfg.robot, split=cfg.split, fps=RECORD_FPS, cameras=())
     manifest = open_manifest(cfg.out_dir, cfg.robot, cfg.split, cfg.seed_start, command="tavis teleop")
     seed = max(manifest.tried_seeds(cfg.task), default=cfg.seed_start - 1) + 1
-    outcomes, window = [], None
+    window, last = None, None
+
+    def show_in_window(command: TeleopCommand, ticks: int) -> None:
+        window.overlay(key_map_columns(), episode_state_columns(
+            seed, ticks / RECORD_FPS, env._max_episode_steps / RECORD_FPS, command, manifest.kept(cfg.task),
+            cfg.episodes, last))
+        window.show()
+
     try:
         if keys is None:
             env.reset(seed=seed)
             window = Window(env, cfg.view)
-            keys, show = window.keys, window.show
+            keys, show = window.keys, show_in_window
         while manifest.kept(cfg.task) < cfg.episodes and (window is None or window.running):
             ending, success, actions, states = teleop_episode(env, seed, keys, show, gamepad)
-            if ending == DROP:
-                outcomes.append(f"seed {seed}: dropped")
-            else:
-                kept = success or cfg.keep_failures
+            kept = ending != DROP and (success or cfg.keep_failures)
+            if ending != DROP:
                 entry = ManifestEntry(cfg.task, seed, success, len(actions))
                 store_episode(cfg.out_dir, manifest, entry,
                               states.episode(env, seed, success, actions) if kept else None)
-                outcomes.append(f"seed {seed}: {'success' if success else 'failure'}, "
-                                f"{'kept' if kept else 'not kept'} ({len(actions)} steps)")
+            last = outcome_line(seed, ending, success, kept, len(actions))
+            yield last
             seed += 1
     finally:
         if window is not None:
@@ -215,4 +251,3 @@ def _teleop(cfg: TeleopConfig, keys: Callable[[], list[int]] | None, show: Calla
         if gamepad is not None:
             gamepad.stop()
         env.close()
-    return outcomes

@@ -2,7 +2,8 @@
 paused; and the real-time window loop that `tavis teleop` shares.
 
 Keys in the window: SPACE pauses and resumes, N starts the next seed, R restarts the episode; the mouse moves the
-free camera; closing the window quits. The viewer needs a display: a desktop session, or a virtual one
+free camera, which starts where the scene's overview camera looks from (robot, table and objects in view);
+closing the window quits. The viewer needs a display: a desktop session, or a virtual one
 (`xvfb-run -a tavis view ...`). With the demonstrator the env runs at the 60 Hz control rate, one tick per frame;
 with a policy at its 20 Hz step rate, the camera mode and image size it was trained with, one step per frame.
 """
@@ -21,9 +22,10 @@ import numpy as np
 from lerobot_tavis import checks
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.checkpoint_settings import pretrained_model_dir, read_checkpoint_settings
-from lerobot_tavis.envs.modes import CAMERA_NAMES, VIEW_CAMERAS
+from lerobot_tavis.envs.modes import CAMERA_NAMES, OVERVIEW_CAMERA, VIEW_CAMERAS
 from lerobot_tavis.envs.physics import CONTROL_HZ, POLICY_HZ
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
+from lerobot_tavis.envs.scene import TABLE_TOP_Z
 from lerobot_tavis.envs.tasks.catalog import split_names, task_names
 from lerobot_tavis.errors import FieldError, InputError, TavisError
 from lerobot_tavis.policies import register_policy_types
@@ -65,8 +67,19 @@ class Window:
         if camera != FREE_CAMERA:
             self._handle.cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
             self._handle.cam.fixedcamid = env.world.cameras[camera]
+        else:
+            with self._handle.lock():
+                aim_like(self._handle.cam, env.data, env.world.cameras[OVERVIEW_CAMERA])
         self._period_s = 1.0 / rate_hz
         self._next_frame = time.perf_counter()
+
+    def overlay(self, top_left: tuple[str, str], bottom_left: tuple[str, str]) -> None:
+        """Text drawn over the scene from the next frame on: two boxes of two columns each (lines split by "\\n")."""
+        import mujoco
+
+        self._handle.set_texts([
+            (mujoco.mjtFontScale.mjFONTSCALE_150, mujoco.mjtGridPos.mjGRID_TOPLEFT, *top_left),
+            (mujoco.mjtFontScale.mjFONTSCALE_150, mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, *bottom_left)])
 
     def keys(self) -> list[int]:
         pressed = []
@@ -94,6 +107,19 @@ class Window:
         self._handle.close()
         for thread in self._ui_threads:
             thread.join(timeout=CLOSE_TIMEOUT_S)
+
+
+def aim_like(free_camera, data, camera_id: int, look_at_z_m: float = TABLE_TOP_Z) -> None:
+    """Place MuJoCo's free camera (an `mjvCamera`) where camera `camera_id` of `data` is, looking the same way: its
+    orbit centre is where that camera's line of sight meets the height `look_at_z_m` (world frame, m; the table top
+    by default), or 1 m ahead when it looks up."""
+    position = data.cam_xpos[camera_id]
+    forward = -data.cam_xmat[camera_id].reshape(3, 3)[:, 2]  # a camera looks along its -z axis
+    distance = (look_at_z_m - position[2]) / forward[2] if forward[2] < 0 else 1.0
+    free_camera.lookat[:] = position + distance * forward
+    free_camera.distance = distance
+    free_camera.azimuth = np.degrees(np.arctan2(forward[1], forward[0]))
+    free_camera.elevation = np.degrees(np.arcsin(np.clip(forward[2], -1.0, 1.0)))
 
 
 class PolicyDriver:
@@ -142,8 +168,8 @@ class ViewConfig:
     policy: str | None = option(None, "a checkpoint's pretrained_model folder; its camera mode and image size apply "
                                 "(default: none)")
     device: str = option("cpu", "the policy's device (default cpu)")
-    camera: str = option(FREE_CAMERA, "the window's camera (default: the free camera, moved with the mouse)",
-                         choices=WINDOW_CAMERAS)
+    camera: str = option(FREE_CAMERA, "the window's camera (default: the free camera, moved with the mouse, starting "
+                         "from the overview camera's viewpoint)", choices=WINDOW_CAMERAS)
     # stop after this many frames (tests, scripted demos); None: until the window closes
     max_frames: int | None = option(None, command_line=False)
 

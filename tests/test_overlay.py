@@ -25,18 +25,36 @@ def has_colour(region, colour, tolerance=40):
     return bool(np.any(np.all(np.abs(region.astype(int) - colour) < tolerance, axis=-1)))
 
 
-def test_layout_overview_left_views_in_a_grid_band_below():
+def test_three_views_stand_in_one_column_beside_the_overview_no_tile_empty():
     frame = compose(views(), solid(GREY), Caption("pick the can", 1.0, 20.0))
-    panel_h, panel_w = PANEL_HEIGHT, 2 * 480  # the 60x80 overview scaled to 360x480, the views' block beside it
-    assert frame.shape == (panel_h + band_height(panel_w), panel_w, 3)
+    panel_h, overview_w = PANEL_HEIGHT, 480  # the 60x80 overview scaled to 360x480
+    cell_h, cell_w = panel_h // 3, overview_w // 3  # the views at a third of its size, one above the other
+    assert frame.shape == (panel_h + band_height(overview_w + cell_w), overview_w + cell_w, 3)
     assert frame.shape[0] % 2 == 0 and frame.shape[1] % 2 == 0
-    below_labels = panel_h // 4  # sample cell centres, away from the name labels in their top-left corners
-    assert colour_at(frame, panel_h // 2, panel_w // 4) == GREY
-    cell_w = panel_w // 4
-    assert colour_at(frame, below_labels, 2 * cell_w + cell_w // 2) == RED  # head: top left of the grid
-    assert colour_at(frame, below_labels, 3 * cell_w + cell_w // 2) == BLUE  # left wrist: top right
-    assert colour_at(frame, 3 * below_labels, 2 * cell_w + cell_w // 2) == GREEN_VIEW  # right wrist: bottom left
-    assert colour_at(frame, 3 * below_labels, 3 * cell_w + cell_w // 2) == (0, 0, 0)  # no fourth view
+    assert colour_at(frame, panel_h // 2, overview_w // 2) == GREY
+    centre_x = overview_w + cell_w // 2
+    for row, colour in enumerate((RED, BLUE, GREEN_VIEW)):  # head, left wrist, right wrist, from the top
+        assert colour_at(frame, row * cell_h + 3 * cell_h // 4, centre_x) == colour  # below the cell's label
+
+
+def test_four_views_fill_a_two_by_two_grid():
+    four = {**views(), "fixed": solid((200, 200, 30))}
+    frame = compose(four, solid(GREY), Caption("p", 1.0, 20.0))
+    assert frame.shape[1] == 2 * 480
+    cell_h, cell_w = PANEL_HEIGHT // 2, 240
+    centres = [(3 * cell_h // 4 + row * cell_h, 480 + cell_w // 2 + col * cell_w) for row in (0, 1) for col in (0, 1)]
+    assert [colour_at(frame, y, x) for y, x in centres] == [RED, BLUE, GREEN_VIEW, (200, 200, 30)]
+
+
+def test_labels_are_white_on_a_dark_box_and_grow_with_the_image():
+    from lerobot_tavis.media import label
+
+    small, large = (label(solid((180, 180, 180), size), "head") for size in ((120, 160), (360, 480)))
+    for image in (small, large):
+        corner = image[:image.shape[0] // 5, :image.shape[1] // 2]
+        assert corner.max() > 240 and corner.min() < 80  # white text over a darkened box
+    text_height = [np.ptp(np.flatnonzero((image[:, :30] > 200).all(axis=-1).any(axis=1))) for image in (small, large)]
+    assert 8 <= text_height[0] < text_height[1]
 
 
 def test_one_view_fills_the_block_beside_the_overview():
@@ -57,7 +75,7 @@ def test_success_shows_only_from_the_step_it_happened():
     events = EpisodeEvents(success=3.0)
     base = compose(views(), solid(GREY), Caption("p", 0.0, 20.0, events))
     band = band_height(base.shape[1])
-    upper_line = slice(base.shape[0] - band, base.shape[0] - band + int(0.38 * band))  # prompt, clock, badge
+    upper_line = slice(base.shape[0] - band, base.shape[0] - band + int(0.28 * band))  # prompt, clock, badge
     before = redraw_caption(base, Caption("p", 2.9, 20.0, events))[upper_line]
     after = redraw_caption(base, Caption("p", 3.0, 20.0, events))[upper_line]
     assert not has_colour(before, EVENT_COLOURS["success"]) and has_colour(after, EVENT_COLOURS["success"])
@@ -67,7 +85,7 @@ def test_success_shows_only_from_the_step_it_happened():
 def test_each_event_is_ticked_where_it_happened_on_the_timeline(name, time_s):
     frame = compose(views(), solid(GREY), Caption("p", 0.0, 20.0, EpisodeEvents(**{name: time_s})))
     band = frame[-band_height(frame.shape[1]):]
-    bar_rows = band[int(0.45 * len(band)):int(0.62 * len(band))]  # around the timeline, above the legend
+    bar_rows = band[int(0.52 * len(band)):int(0.70 * len(band))]  # around the timeline, above the legend
     columns = np.flatnonzero([has_colour(bar_rows[:, x:x + 1], EVENT_COLOURS[name], 30)
                               for x in range(frame.shape[1])])
     tick_x = columns.mean()
@@ -76,13 +94,29 @@ def test_each_event_is_ticked_where_it_happened_on_the_timeline(name, time_s):
     assert abs(tick_x - expected) < 0.06 * width
 
 
-def test_a_long_prompt_is_cut_with_an_ellipsis_not_drawn_over_the_clock():
-    words = "look at the card and pick the object on its side " * 8
-    frame = compose(views(), solid(GREY), Caption(words, 12.5, 20.0))
-    band = frame[-band_height(frame.shape[1]):]
-    assert band.max() > 200  # text drawn
-    right_margin = band[:, -6:]
-    assert right_margin.max() < 60  # nothing runs off the right edge
+def test_a_long_prompt_is_wrapped_whole_not_cut_nor_drawn_over_the_clock():
+    from lerobot_tavis.envs.tasks.catalog import task_info
+    from lerobot_tavis.overlay import text_scale, wrap
+
+    prompt = task_info("conditional_pick").prompts[0]  # its green branch was cut off
+    frame = compose(views(), solid(GREY), Caption(prompt, 12.5, 20.0))
+    width = frame.shape[1]
+    scale, lines = wrap(prompt, 3 * width // 4, text_scale(width), 1, 2)  # about the room left of the clock
+    assert len(lines) == 2 and " ".join(lines) == prompt and scale == text_scale(width)
+    band = frame[-band_height(width):]
+    second_line = band[int(0.28 * len(band)):int(0.5 * len(band)), :width // 2]
+    assert second_line.max() > 200  # the prompt's second line is drawn
+    assert band[:, -6:].max() < 60  # nothing runs off the right edge
+
+
+def test_a_prompt_too_long_for_two_lines_is_drawn_smaller_and_cut_only_past_half_size():
+    from lerobot_tavis.overlay import wrap
+
+    words = "look at the card and pick the object on its side " * 3
+    scale, lines = wrap(words, 400, 0.5, 1, 2)
+    assert len(lines) == 2 and scale < 0.5 and " ".join(lines) == words.strip()
+    scale, lines = wrap(words * 10, 400, 0.5, 1, 2)
+    assert len(lines) == 2 and scale == pytest.approx(0.25) and lines[-1].endswith("...")
 
 
 def test_events_of_an_episode_log_record():

@@ -23,3 +23,28 @@ def test_the_wheel_carries_every_asset(tmp_path):
     assert [a for a in assets if a not in packed] == []
     size_mb = sum(info.file_size for info in zipfile.ZipFile(wheel).infolist() if "/assets/" in info.filename) / 1e6
     assert size_mb <= 25.0
+
+
+def _make_setup(tmp_path, *settings: str) -> tuple[subprocess.CompletedProcess, list[str]]:
+    """`make setup` with a stand-in `python` in a scratch venv that logs its arguments and fails where it is asked
+    for the PyTorch CPU index: (the result, the logged calls)."""
+    venv = tmp_path / "venv"
+    (venv / "bin").mkdir(parents=True)
+    log = tmp_path / "calls"
+    python = venv / "bin" / "python"
+    python.write_text(f'#!/bin/sh\necho "$*" >> {log}\ncase "$*" in *--index-url*) exit 1;; esac\n')
+    python.chmod(0o755)
+    result = subprocess.run(["make", "--no-print-directory", "setup", f"VENV={venv}", *settings], cwd=ROOT,
+                            capture_output=True, text=True, timeout=120)
+    return result, log.read_text().splitlines()
+
+
+def test_setup_with_cpu_installs_torch_from_the_cpu_index_before_the_package(tmp_path):
+    result, calls = _make_setup(tmp_path)
+    assert result.returncode == 0 and not [call for call in calls if "--index-url" in call]
+    assert calls[-1] == "-m pip install -e .[dev]"
+    result, calls = _make_setup(tmp_path / "cpu", "CPU=1")
+    assert result.returncode != 0
+    assert calls[-1].startswith("-m pip install --index-url https://download.pytorch.org/whl/cpu torch>=2.7,<2.12 ")
+    assert "CPU=1: PyTorch's CPU wheels could not be installed" in result.stdout + result.stderr
+    assert not (tmp_path / "cpu" / "venv" / ".installed").exists()

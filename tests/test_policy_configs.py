@@ -176,7 +176,11 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
 
 def test_pi0_presets_say_clearly_what_is_missing_offline(tmp_path):
     env = {**os.environ, "HF_HUB_OFFLINE": "1", "HF_HOME": str(tmp_path / "hf"), "HF_TOKEN": ""}
-    result = subprocess.run([sys.executable, "-m", "lerobot_tavis.cli", "train", "pi0_head_only", "--steps=1"],
+    dataset = tmp_path / "dataset"  # checked first: it only needs to look like one
+    (dataset / "meta").mkdir(parents=True)
+    (dataset / "meta" / "info.json").write_text("{}")
+    result = subprocess.run([sys.executable, "-m", "lerobot_tavis.cli", "train", "pi0_head_only", "--steps=1",
+                             f"--dataset.root={dataset}"],
                             capture_output=True, text=True, env=env, timeout=120)
     assert result.returncode == 1
     assert "tavis train: error: pi0 needs lerobot/pi0_base" in result.stderr

@@ -8,7 +8,8 @@ import pytest
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
 from lerobot_tavis.teleop import (DROP, END, HAND_STEP_M, HEAD_STEP_RAD, KEY_BACKSPACE, KEY_DOWN, KEY_ENTER, KEY_LEFT,
-                                  KEY_SPACE, KEY_TAB, TeleopCommand, TeleopConfig, teleop)
+                                  KEY_MAP, KEY_SPACE, KEY_TAB, TeleopCommand, TeleopConfig, episode_state_columns,
+                                  key_map_columns, teleop)
 
 
 def test_keys_move_the_active_hand_the_head_and_the_grippers():
@@ -48,6 +49,10 @@ def scripted(presses: dict[int, list[int]]):
     return keys
 
 
+def unseen(command, ticks):
+    """A `show` that draws nothing."""
+
+
 def test_recorded_episodes_are_raw_episodes_that_convert_reads(tmp_path):
     # Episode 1 (seed 200000): dropped at tick 5. Episode 2 (seed 200001): the right hand moves forward and up
     # and the head looks down for 60 ticks, then ENTER ends it: a failure, kept with keep_failures.
@@ -55,7 +60,7 @@ def test_recorded_episodes_are_raw_episodes_that_convert_reads(tmp_path):
     presses.update({6 + t: [ord("W"), ord("Q"), KEY_DOWN] for t in range(0, 30, 3)})
     presses[6 + 60] = [KEY_ENTER]
     cfg = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=1, keep_failures=True)
-    outcomes = teleop(cfg, keys=scripted(presses), show=lambda: None)
+    outcomes = list(teleop(cfg, keys=scripted(presses), show=unseen))
     assert outcomes == ["seed 200000: dropped", "seed 200001: failure, kept (60 steps)"]
 
     manifest = json.loads((tmp_path / "raw" / "manifest.json").read_text())
@@ -76,9 +81,9 @@ def test_recorded_episodes_are_raw_episodes_that_convert_reads(tmp_path):
 
 def test_a_rerun_continues_with_the_next_seed(tmp_path):
     cfg = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=1, keep_failures=True)
-    teleop(cfg, keys=scripted({3: [KEY_ENTER]}), show=lambda: None)
+    list(teleop(cfg, keys=scripted({3: [KEY_ENTER]}), show=unseen))
     more = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=2, keep_failures=True)
-    assert teleop(more, keys=scripted({3: [KEY_ENTER]}), show=lambda: None) == [
+    assert list(teleop(more, keys=scripted({3: [KEY_ENTER]}), show=unseen)) == [
         "seed 200001: failure, kept (3 steps)"]
 
 
@@ -88,7 +93,7 @@ def test_without_a_display_it_says_how_to_get_one(tmp_path, monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     with pytest.raises(NoDisplayError, match="xvfb-run -a tavis teleop"):
-        teleop(TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick"))
+        list(teleop(TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick")))
     assert not (tmp_path / "raw").exists()
 
 
@@ -121,7 +126,7 @@ def test_a_gamepad_moves_the_active_hand_closes_its_gripper_and_ends_the_episode
     ticks += [((0.0, 0.0, 0.0), "stay", TeleopEvents.FAILURE)]
     gamepad = ScriptedGamepad(ticks)
     cfg = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=1, keep_failures=True)
-    assert teleop(cfg, keys=scripted({0: [KEY_TAB]}), show=lambda: None, gamepad=gamepad) == [
+    assert list(teleop(cfg, keys=scripted({0: [KEY_TAB]}), show=unseen, gamepad=gamepad)) == [
         "seed 200000: failure, kept (35 steps)"]
     assert gamepad.stopped
     from lerobot_tavis.dataset_tools.raw import load_episode
@@ -132,3 +137,33 @@ def test_a_gamepad_moves_the_active_hand_closes_its_gripper_and_ends_the_episode
     np.testing.assert_allclose(moved, [0.030, 0.0, 0.060], atol=1e-9)
     assert episode.actions[-1][canonical.LEFT.gripper] == canonical.GRIPPER_CLOSED
     np.testing.assert_array_equal(episode.actions[-1][canonical.RIGHT.position], rest[canonical.RIGHT.position])
+
+
+def test_a_failed_episode_not_kept_says_so_as_it_ends_and_on_screen(tmp_path):
+    """Without --keep-failures an episode ended by ENTER is discarded: its line says so (and how to keep it) the
+    moment it ends, and the window's state shows it during the next episode."""
+    cfg = TeleopConfig(out_dir=tmp_path / "raw", task="conditional_pick", episodes=1)
+    shown = []
+    outcomes = teleop(cfg, keys=scripted({3: [KEY_ENTER], 8: [KEY_TAB]}),
+                      show=lambda command, ticks: shown.append(episode_state_columns(
+                          0, ticks / 60, 20.0, command, 0, 1, None)[1]))
+    first = next(outcomes)
+    assert first == "seed 200000: failure, not kept (3 steps; --keep-failures keeps failed episodes)"
+    assert len(shown) == 4  # the start and three ticks: the line came as the episode ended, not at the end
+    outcomes.close()  # stops the session: the window (here none) and the env close
+    manifest = json.loads((tmp_path / "raw" / "manifest.json").read_text())
+    assert manifest["episodes"] == [] and [entry["seed"] for entry in manifest["discarded"]] == [200000]
+    assert shown[0].splitlines()[1:3] == [" 0.0 / 20 s", "right, gripper open"]
+
+
+def test_the_window_shows_the_key_map_and_the_episode_state():
+    keys, does = key_map_columns()
+    assert keys.splitlines()[0] == "W / S" and "ENTER" in keys and "BACKSPACE" in keys
+    assert len(keys.splitlines()) == len(does.splitlines()) == len(KEY_MAP)
+    command = TeleopCommand()
+    command.press(KEY_TAB)
+    command.press(KEY_SPACE)
+    labels, values = episode_state_columns(200001, 3.25, 20.0, command, 1, 2, "seed 200000: success, kept (90 steps)")
+    assert dict(zip(labels.splitlines(), values.splitlines())) == {
+        "seed": "200001", "time": " 3.2 / 20 s", "hand": "left, gripper closed", "kept": "1 of 2",
+        "last": "seed 200000: success, kept (90 steps)"}

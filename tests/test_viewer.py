@@ -33,6 +33,7 @@ window = Window(env, camera="head")
 following = window._handle.cam.fixedcamid == env.world.cameras["head"]
 window._pressed.put(32)  # what the viewer's key callback does on SPACE
 keys = [window.keys(), window.keys()]
+window.overlay(("W / S", "hand forward / back"), ("seed", "200000"))  # what teleop draws over the scene
 window.show()
 window.close()
 print(json.dumps({"following": bool(following), "keys": keys}))
@@ -125,3 +126,24 @@ def test_without_a_display_view_says_how_to_get_one(monkeypatch):
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     with pytest.raises(NoDisplayError, match="xvfb-run -a tavis view"):
         view(ViewConfig(task="conditional_pick"))
+
+
+def test_the_free_camera_starts_where_the_overview_camera_looks_from():
+    """`tavis view` opens on the scene's overview (robot, table and objects), not on the robot's legs."""
+    import mujoco
+
+    from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.viewer import aim_like
+
+    env = TavisEnv("conditional_pick", "gr1t2", fps=60, cameras=())
+    env.reset(seed=0)
+    overview = env.world.cameras["overview"]
+    camera = mujoco.MjvCamera()
+    aim_like(camera, env.data, overview)
+    azimuth, elevation = np.radians(camera.azimuth), np.radians(camera.elevation)
+    looking = np.array([np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)])
+    eye = camera.lookat - camera.distance * looking  # where MuJoCo puts a free camera
+    np.testing.assert_allclose(eye, env.data.cam_xpos[overview], atol=1e-9)
+    np.testing.assert_allclose(looking, -env.data.cam_xmat[overview].reshape(3, 3)[:, 2], atol=1e-9)
+    assert camera.lookat[2] == pytest.approx(1.0) and camera.elevation < 0  # aimed down at the table top
+    env.close()

@@ -116,8 +116,11 @@ def convert_from_tavis(source_root: str | Path, repo_id: str, root: str | Path, 
 
     quiet_media_libraries()
     with staged_directory(root, overwrite=overwrite) as staging:
+        # LeRobot's streaming encoder (threads, every frame kept: queue unbounded, as `convert` uses it): its
+        # default encodes each saved episode's cameras in a process pool forked from this multi-threaded process
         dataset = LeRobotDataset.create(repo_id, fps=fps, root=staging, robot_type=robot, use_videos=True,
-                                        features=ft.dataset_features(joint_names, cameras.values(), size))
+                                        features=ft.dataset_features(joint_names, cameras.values(), size),
+                                        streaming_encoding=True, encoder_queue_maxsize=0)
         try:
             for index, task_name in tqdm(episodes, desc=f"import {source_root.name}", unit="ep",
                                          disable=not progress):

@@ -3,11 +3,16 @@
 LeRobot's writer encodes videos through PyAV: FFmpeg logs a line per file ("Starting second pass: moving the moov
 atom ..."), the SVT-AV1 encoder prints its 20-line banner and configuration for every video it opens, and the
 `datasets` library draws a "Map" progress bar per saved episode. Errors still reach stderr.
+
+Where torchcodec cannot load (FFmpeg's shared libraries missing: `make setup` installs them), LeRobot logs
+torchcodec's whole error, one traceback per FFmpeg version it tried, before it decodes with PyAV instead;
+`shorten_torchcodec_fallback` makes that warning one line saying what to install.
 """
 
 from __future__ import annotations
 
 import ctypes
+import logging
 import os
 from pathlib import Path
 
@@ -47,3 +52,25 @@ def video_backend() -> str:
     except Exception:  # torchcodec raises RuntimeError (and others) listing every FFmpeg it tried
         return "pyav"
     return "torchcodec"
+
+
+FALLBACK_LOGGER = "lerobot.utils.import_utils"  # where LeRobot's `get_safe_default_video_backend` logs
+FALLBACK_MARK = "'torchcodec' is installed but cannot be loaded"  # in that warning, after torchcodec's error
+FALLBACK_LINE = ("torchcodec cannot load FFmpeg's shared libraries (Debian/Ubuntu: apt-get install ffmpeg, which "
+                 "`make setup` runs); videos are decoded with PyAV instead")
+
+
+class _OneLineTorchcodecFallback(logging.Filter):
+    """Rewrites LeRobot's torchcodec fallback warning to FALLBACK_LINE; other records pass unchanged."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if FALLBACK_MARK in record.getMessage():
+            record.msg, record.args = FALLBACK_LINE, ()
+        return True
+
+
+def shorten_torchcodec_fallback() -> None:
+    """Make LeRobot's warning that torchcodec cannot load one line (FALLBACK_LINE), in this process."""
+    logger = logging.getLogger(FALLBACK_LOGGER)
+    if not any(isinstance(existing, _OneLineTorchcodecFallback) for existing in logger.filters):
+        logger.addFilter(_OneLineTorchcodecFallback())

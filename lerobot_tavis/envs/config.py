@@ -30,7 +30,7 @@ from lerobot_tavis.envs.checkpoint_settings import SETTINGS, match_settings, rea
 from lerobot_tavis.envs.factory import EPISODE_LOG_NAME, make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_info
-from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split
+from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split, suite_tasks
 from lerobot_tavis.envs.vector import Frozen, LazyAsyncVectorEnv
 from lerobot_tavis.errors import FieldError
 from lerobot_tavis.process import MAX_NICENESS
@@ -105,12 +105,18 @@ class TavisEnvConfig(EnvConfig):
                 "image_size": tuple(self.image_size), "episode_length_s": self.episode_length_s}
 
     def sub_env_factories(self) -> dict[str, dict[int, partial]]:
-        """One sub-env factory per task of `task`, by suite and index in the suite: what `create_envs` batches."""
+        """One sub-env factory per task of `task`, by suite and the task's index in its whole suite (so a run of
+        some tasks files each one's videos and results under the `<suite>_<index>` of a whole suite's run): what
+        `create_envs` batches."""
         log = self.episode_log or command_line_episode_log()
-        return {suite: {task_id: partial(make_tavis_env, task, episode_log=str(log) if log else None, suite=suite,
-                                         task_id=task_id, **self.gym_kwargs)
-                        for task_id, task in enumerate(tasks)}
-                for suite, tasks in expand_tasks(self.task).items()}
+        factories: dict[str, dict[int, partial]] = {}
+        for suite, tasks in expand_tasks(self.task).items():
+            factories[suite] = {}
+            for task in tasks:
+                task_id = suite_tasks(suite).index(task)
+                factories[suite][task_id] = partial(make_tavis_env, task, episode_log=str(log) if log else None,
+                                                    suite=suite, task_id=task_id, **self.gym_kwargs)
+        return factories
 
     def match_command_line_policy(self, args: list[str] | None = None) -> None:
         """Match robot, camera mode and image size to the checkpoint of `--policy.path` on the command line (default:

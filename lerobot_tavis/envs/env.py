@@ -29,6 +29,8 @@ from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.world import World, build_world
 from lerobot_tavis.errors import FieldError
 
+HAND_REACH_M = 1.5  # hand positions of action and state lie within this of the hip, per canonical axis
+JOINT_BOUND = 2 * np.pi  # joint_pos bound: every robot joint is a limited hinge (rad) or finger slide (m)
 SETTLE_MAX_S = 1.5
 SETTLE_MIN_S = 0.1
 SETTLE_SPEED_M_S = 0.005
@@ -132,8 +134,8 @@ class TavisEnv(gym.Env):
         self.observation_space = gym.spaces.Dict({
             "pixels": gym.spaces.Dict({
                 name: gym.spaces.Box(0, 255, (height, width, 3), np.uint8) for name in self.camera_names}),
-            "agent_pos": gym.spaces.Box(-np.inf, np.inf, (canonical.ACTION_DIM,), np.float32),
-            "joint_pos": gym.spaces.Box(-np.inf, np.inf, (n_joints,), np.float32),
+            "agent_pos": _state_space(),
+            "joint_pos": gym.spaces.Box(-JOINT_BOUND, JOINT_BOUND, (n_joints,), np.float32),
         })
         self.action_space = _action_space(self._robot.neck_range_rad())
 
@@ -315,11 +317,21 @@ def _check_cameras(cameras) -> tuple[str, ...]:
 
 
 def _action_space(neck_range: np.ndarray) -> gym.spaces.Box:
-    """Bounds of the canonical action: hand positions within 1.5 m of the hip, unit quaternions, neck joint
-    ranges, grippers in [-1, 1]. Values outside are still accepted (see TavisEnv)."""
+    """Bounds of the canonical action: hand positions within HAND_REACH_M of the hip, unit quaternions, neck joint
+    ranges (rad), grippers in [-1, 1]. Values outside are still accepted (see TavisEnv)."""
+    return _canonical_box(neck_range[:, 0], neck_range[:, 1])
+
+
+def _state_space() -> gym.spaces.Box:
+    """Bounds of the measured canonical state: the action's, with the head angles within a half turn (rad) instead of
+    the neck's ranges, which a joint may overshoot slightly under load."""
+    return _canonical_box(-np.pi, np.pi)
+
+
+def _canonical_box(head_low, head_high) -> gym.spaces.Box:
     low = np.full(canonical.ACTION_DIM, -1.0)
     high = np.full(canonical.ACTION_DIM, 1.0)
     for arm in canonical.ARMS:
-        low[arm.position], high[arm.position] = -1.5, 1.5
-    low[canonical.HEAD], high[canonical.HEAD] = neck_range[:, 0], neck_range[:, 1]
+        low[arm.position], high[arm.position] = -HAND_REACH_M, HAND_REACH_M
+    low[canonical.HEAD], high[canonical.HEAD] = head_low, head_high
     return gym.spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)

@@ -201,8 +201,7 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
         evaluate(pipeline_config(env=env, eval=batches, policy=policy, output_dir=out, seed=chunk.first_seed,
                                  job_name=f"tavis_{chunk.task}_{chunk.split}"), keep_workers=True)
         task_metrics = json.loads((out / EVAL_INFO_NAME).read_text())["per_task"][0]["metrics"]
-        lines = sorted((json.loads(line) | {"task_id": chunk.task_id}  # the run saw a one-task suite
-                        for line in (out / EPISODE_LOG_NAME).read_text().splitlines()),
+        lines = sorted((json.loads(line) for line in (out / EPISODE_LOG_NAME).read_text().splitlines()),
                        key=lambda record: record["seed"])  # async envs log in the order episodes finish
         videos = {path.name: path.read_bytes() for path in sorted((out / "videos").rglob("*.mp4"))}
         return ChunkResult(chunk, "".join(json.dumps(line) + "\n" for line in lines),

@@ -8,7 +8,8 @@ and processors from the same `EvalPipelineConfig`), then calls LeRobot's `eval_p
 the sub-envs that draw frames (`TavisEnvConfig.filmed_envs`); it writes the same `eval_info.json`. With
 `filmed_envs=0` no frame is rendered for a video at all.
 
-Its rollout converts each step's camera images from uint8 to float on the device instead of the CPU
+LeRobot's own progress bars (one per batch and one per rollout, nested) are off: the caller draws one bar for its
+whole run (`tavis eval`'s `cell_runs`). Its rollout converts each step's camera images from uint8 to float on the device instead of the CPU
 (`images_converted_on`), to the same values as LeRobot's own conversion. A process that runs
 one task after another (`tavis eval --policy`'s jobs) can keep its env workers between runs (`keep_workers`): the
 next run's task and split are built in the same worker processes.
@@ -101,6 +102,19 @@ def images_converted_on(device):
         lerobot_eval.preprocess_observation = lerobots
 
 
+@contextmanager
+def without_lerobot_progress_bars():
+    """Within the context, lerobot-eval draws no progress bar: its bars are off where `inside_slurm()` says so."""
+    from lerobot.scripts import lerobot_eval
+
+    inside_slurm = lerobot_eval.inside_slurm
+    lerobot_eval.inside_slurm = lambda: True
+    try:
+        yield
+    finally:
+        lerobot_eval.inside_slurm = inside_slurm
+
+
 def close_kept_envs() -> None:
     """Stop the env workers this process kept for a next run."""
     while _KEPT:
@@ -182,7 +196,7 @@ def evaluate(cfg, keep_workers: bool = False) -> None:
                                     "rename_observations_processor": {"rename_map": cfg.rename_map}})
         env_preprocessor, env_postprocessor = make_env_pre_post_processors(env_cfg=cfg.env, policy_cfg=cfg.policy)
         autocast = torch.autocast(device_type=device.type) if cfg.policy.use_amp else nullcontext()
-        with torch.no_grad(), autocast, images_converted_on(device):
+        with torch.no_grad(), autocast, images_converted_on(device), without_lerobot_progress_bars():
             info = eval_policy_all(envs=envs, policy=policy, env_preprocessor=env_preprocessor,
                                    env_postprocessor=env_postprocessor, preprocessor=preprocessor,
                                    postprocessor=postprocessor, n_episodes=cfg.eval.n_episodes,

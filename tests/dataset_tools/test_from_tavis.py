@@ -64,7 +64,7 @@ def make_source(root, robot_type, episodes, *, cameras=("OBS_HEAD", "OBS_FIXED")
         frames = [source_frame(e, k, joints, cameras) for k in range(length)]
         for frame in frames:
             dataset.add_frame({**frame, "language_instruction": PROMPTS[class_name], "task": class_name})
-        dataset.save_episode()
+        dataset.save_episode(parallel_encoding=False)  # its pool would fork this multi-threaded process
         source.episodes.append({key: np.stack([f[key] for f in frames]) for key in frames[0]})
     dataset.finalize()
     return source

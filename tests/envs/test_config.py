@@ -1,6 +1,7 @@
 """`--env.type=tavis` as LeRobot uses it: registry, features, create_envs (sync and forkserver async), seeds."""
 
 import os
+import warnings
 from functools import partial
 from pathlib import Path
 
@@ -14,6 +15,7 @@ from lerobot.envs.utils import preprocess_observation
 import lerobot_env_tavis  # noqa: F401  (registers the env type, as LeRobot's CLIs do)
 from lerobot_tavis import canonical
 from lerobot_tavis.envs.config import TavisEnvConfig, expand_tasks
+from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.envs.env import scene_seed
 from lerobot_tavis.envs.vector import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd, LazyAsyncVectorEnv
 from lerobot_tavis.eval.episode_log import EpisodeLogger
@@ -75,9 +77,20 @@ def test_sync_create_envs_wraps_every_sub_env_and_runs():
             v.close()
 
 
+def test_each_task_keeps_its_index_in_its_suite_whatever_else_runs():
+    """lerobot-eval files a task's videos and results under `<suite>_<task_id>`: one task alone goes where the
+    same task of a whole suite's run goes."""
+    ids = {suite: list(factories) for suite, factories in TavisEnvConfig(
+        task="multi_shelf_scan,occluded_reach,wait_then_act").sub_env_factories().items()}
+    assert ids == {"tavis_head": [4, 1], "tavis_hands": [1]}
+    whole = TavisEnvConfig(task="tavis_head").sub_env_factories()["tavis_head"]
+    assert [factory.args[0] for factory in whole.values()] == list(suite_tasks("tavis_head"))
+    assert [factory.keywords["task_id"] for factory in whole.values()] == list(whole)
+
+
 def test_async_create_envs_run_in_forkserver_workers():
     config = TavisEnvConfig(task="wait_then_act", image_size=(24, 32))
-    vec = config.create_envs(n_envs=2, use_async_envs=True)["tavis_head"][0]
+    vec = config.create_envs(n_envs=2, use_async_envs=True)["tavis_head"][1]
     assert isinstance(vec, LazyAsyncVectorEnv)
     obs, _ = vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
     assert obs["pixels"]["head"].shape == (2, 24, 32, 3)
@@ -93,7 +106,7 @@ def test_only_the_filmed_sub_envs_of_an_async_batch_draw_frames():
     """lerobot-eval asks every async sub-env for a frame each step: only the first `filmed_envs` draw one, and only
     theirs come back, so that lerobot-eval films as many episodes."""
     config = TavisEnvConfig(task="wait_then_act", image_size=(24, 32), filmed_envs=1)
-    vec = config.create_envs(n_envs=3, use_async_envs=True)["tavis_head"][0]
+    vec = config.create_envs(n_envs=3, use_async_envs=True)["tavis_head"][1]
     vec.reset(seed=[1000, 1001, 1002], options={NEW_ROLLOUT_OPTION: True})
     frames = vec.call("render")
     unfilmed = vec._started().call("render")[1:]
@@ -153,7 +166,7 @@ def test_retargeted_workers_build_the_new_task_in_the_same_processes():
     expected, _ = fresh.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
     fresh.close()
     vec = TavisEnvConfig(task="wait_then_act", image_size=(24, 32), worker_niceness=3,
-                         filmed_envs=2).create_envs(2, True)["tavis_head"][0]
+                         filmed_envs=2).create_envs(2, True)["tavis_head"][1]
     try:
         vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
         workers = [process.pid for process in vec._started().processes]
@@ -179,13 +192,18 @@ def test_a_retarget_that_fails_in_the_workers_raises_at_the_next_use():
     from lerobot_tavis.envs.factory import make_tavis_env
     from lerobot_tavis.errors import FieldError
 
-    vec = TavisEnvConfig(task="wait_then_act", image_size=(24, 32)).create_envs(2, True)["tavis_head"][0]
+    vec = TavisEnvConfig(task="wait_then_act", image_size=(24, 32)).create_envs(2, True)["tavis_head"][1]
     try:
         vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
         broken = partial(make_tavis_env, "conditional_pick", "gr1t2", "head_wrist", "no_split", (24, 32), 20.0)
         vec.retarget([broken] * 2, filmed_envs=0)
-        with pytest.raises(FieldError, match="split must be one of"):  # the worker's error, type and message
+        with (pytest.raises(FieldError, match="split must be one of"),  # the worker's error, type and message
+              warnings.catch_warnings(record=True) as reported):
+            warnings.simplefilter("always")
             vec.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
+        # gymnasium also reports a worker's error, with its traceback, as warnings
+        assert "Received the following error from Worker" in str(reported[0].message)
+        assert all("ERROR" in str(warning.message) for warning in reported)
     finally:
         vec.close()
 
@@ -215,7 +233,7 @@ def test_tasks_given_the_same_seed_get_their_own_scene():
 
 def _episode_log_of(config: TavisEnvConfig):
     """The path the episode log of create_envs' first sub-env writes to, or None without one."""
-    vec = config.create_envs(n_envs=1)["tavis_head"][0]
+    (vec,) = config.create_envs(n_envs=1)["tavis_head"].values()
     env = vec.envs[0]
     while not isinstance(env, EpisodeLogger) and hasattr(env, "env"):
         env = env.env

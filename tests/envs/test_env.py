@@ -137,8 +137,15 @@ def test_bad_arguments_raise_clear_errors(kwargs, message):
         TavisEnv(**kwargs)
 
 
-def test_gymnasium_env_checker(small_env):
+def test_gymnasium_env_checker(small_env, recwarn):
     check_env(small_env(robot="gr1t2", camera_mode="fixed_only", image_size=(24, 32)), skip_render_check=True)
+    # its one remark: the action is in metres and radians (the canonical action), not normalised to [-1, 1] as it
+    # advises for reinforcement learning; LeRobot's policies normalise actions themselves
+    assert [str(warning.message) for warning in recwarn] == [
+        "\x1b[33mWARN: For Box action spaces, we recommend using a symmetric and normalized space (range=[-1, 1] or "
+        "[0, 1]). See https://stable-baselines3.readthedocs.io/en/master/guide/rl_tips.html for more "
+        "information.\x1b[0m"]
+    recwarn.clear()
 
 
 def test_a_60hz_env_steps_one_control_tick_and_counts_time_in_seconds(small_env):

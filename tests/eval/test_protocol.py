@@ -239,15 +239,18 @@ def _diffusion_checkpoint(path, image_size):
         processor.save_pretrained(path)
 
 
-def test_policy_protocol_runs_through_lerobot_eval(tmp_path):
+def test_policy_protocol_runs_through_lerobot_eval_under_one_progress_bar(tmp_path, capsys):
     _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
     cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("ood_init_pose",),
                          n_episodes=1, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
                          policy_options=(("num_inference_steps", 1),))
+    capsys.readouterr()
     run_protocol(cfg)
     results = json.loads((tmp_path / "eval" / "results.json").read_text())
     assert [(c["task"], c["split"], c["n"]) for c in results["cells"]] == [
         (task, "ood_init_pose", 1) for task in suite_tasks("tavis_head")]
+    bars = {line.split(":")[0] for line in re.split(r"[\r\n]+", capsys.readouterr().err) if "|" in line}
+    assert bars == {"policy"}  # the run's own bar; none of lerobot-eval's batch and rollout bars
 
 
 def _tiny_policy_cell(tmp_path, name: str, suite: str, **settings):
@@ -336,17 +339,18 @@ def test_a_negative_film_count_is_refused(tmp_path):
                                           (["--eval.use_async_envs=true", "--env.filmed_envs=1"], 1)])
 def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path, envs, videos):
     command = [os.path.join(os.path.dirname(sys.executable), "lerobot-eval"), "--env.type=tavis",
-               "--env.task=conditional_pick", "--env.image_size=[32, 48]", "--env.episode_length_s=0.5",
+               "--env.task=wait_then_act", "--env.image_size=[32, 48]", "--env.episode_length_s=0.5",
                "--policy.type=diffusion", "--policy.pretrained_backbone_weights=null", "--policy.device=cpu",
                "--policy.down_dims=[16, 32, 64]", "--policy.num_inference_steps=2", "--eval.n_episodes=2",
                "--eval.batch_size=2", *envs, f"--output_dir={tmp_path / 'out'}"]
     subprocess.run(command, check=True, capture_output=True, text=True, env={**os.environ, "HF_HUB_OFFLINE": "1"})
     info = json.loads((tmp_path / "out" / "eval_info.json").read_text())
-    assert info["per_task"][0]["task_group"] == "tavis_head"
+    assert (info["per_task"][0]["task_group"], info["per_task"][0]["task_id"]) == ("tavis_head", 1)  # its index
     assert len(info["overall"]["video_paths"]) == videos
+    assert all("/videos/tavis_head_1/" in path for path in info["overall"]["video_paths"])
     records = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
     assert sorted(r["seed"] for r in records) == [1000, 1001]
-    assert all("galt_s" in r and r["length_steps"] == 10 for r in records)
+    assert all("galt_s" in r and r["length_steps"] == 10 and r["task_id"] == 1 for r in records)
 
 
 def test_lerobot_eval_of_a_checkpoint_renders_the_size_it_was_trained_at(tmp_path, monkeypatch, caplog):

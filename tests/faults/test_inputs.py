@@ -248,3 +248,42 @@ def test_a_checkpoint_folder_without_its_config_is_one_line(tmp_path):
     checkpoint.mkdir()
     message = _refused(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out")])
     assert message.startswith("tavis eval: error: ") and "config.json" in message and str(checkpoint) in message
+
+
+def test_a_training_without_its_dataset_is_one_line_before_lerobot_train_starts(tmp_path, monkeypatch):
+    monkeypatch.setenv("HF_LEROBOT_HOME", str(tmp_path / "cache"))  # LeRobot's default root: empty
+    assert _refused(["train", "diffusion_head_wrist", "--steps=1"]).startswith(
+        "tavis train: error: no --dataset.root: pass --dataset.root=")
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    for root in (["--dataset.root", str(empty)], [f"--dataset.root={tmp_path / 'missing'}"]):
+        assert _refused(["train", "diffusion_head_wrist", *root]).startswith(
+            f"tavis train: error: --dataset.root {root[-1].removeprefix('--dataset.root=')} holds no LeRobotDataset")
+
+
+def test_a_bad_env_field_in_lerobot_eval_is_one_line(tmp_path):
+    lerobot_eval = os.path.join(os.path.dirname(sys.executable), "lerobot-eval")
+    result = subprocess.run([lerobot_eval, "--env.type=tavis", "--env.task=conditonal_pick", "--policy.type=diffusion",
+                             "--policy.device=cpu", f"--output_dir={tmp_path / 'out'}"],
+                            capture_output=True, text=True, timeout=300, env={**os.environ, "HF_HUB_OFFLINE": "1"})
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr
+    assert result.stderr.splitlines()[-1].startswith("lerobot-eval: error: --env.task must be one of [")
+    assert result.stderr.splitlines()[-1].endswith("got 'conditonal_pick'")
+
+
+def test_other_errors_while_lerobot_parses_keep_their_traceback():
+    from draccus.utils import ParsingError
+
+    from lerobot_tavis.lerobot_cli_errors import env_field_error
+
+    def raised(error, cause):
+        try:
+            raise error from cause
+        except ParsingError as caught:
+            return caught
+
+    field = FieldError("task", "must be one of [...]")
+    assert env_field_error(raised(ParsingError("Couldn't instantiate class TavisEnvConfig"), field)) is field
+    assert env_field_error(raised(ParsingError("Couldn't instantiate class TavisEnvConfig"), TypeError("x"))) is None
+    assert env_field_error(raised(ParsingError("Couldn't instantiate class DiffusionConfig"), field)) is None
