@@ -1,8 +1,14 @@
-"""Offscreen rendering of a camera subset with one MuJoCo renderer (one GL context per env)."""
+"""Offscreen rendering of a camera subset with one MuJoCo renderer (one GL context per env).
+
+Each image draws only the geoms that can show in it or shadow what does (`out_of_view`): MuJoCo draws every geom in
+every pass, and with shadows each image takes three (the lit scene, the shadow map, the shadowed light), so a
+camera that sees a part of the scene saves most of its cost. The pixels are those of drawing everything.
+"""
 
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 
 import mujoco
 import numpy as np
@@ -40,7 +46,8 @@ class CameraRig:
     def render_camera(self, data: mujoco.MjData, camera_id: int) -> np.ndarray:
         """One (H, W, 3) uint8 image from any camera of the model, e.g. one outside the rig for a video."""
         renderer = self._ensure_renderer()
-        renderer.update_scene(data, camera=camera_id)
+        with _left_out(self._model, out_of_view(self._model, data, camera_id, self.width / self.height)):
+            renderer.update_scene(data, camera=camera_id)
         return renderer.render()
 
     def _ensure_renderer(self) -> mujoco.Renderer:
@@ -59,3 +66,61 @@ class CameraRig:
     def close(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
+
+
+def out_of_view(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspect: float) -> np.ndarray:
+    """(ngeom,) bool: the geoms that can neither appear in the image of camera `camera_id` (`aspect` = width /
+    height) nor shadow anything that does, judged by their bounding spheres (`geom_rbound`).
+
+    A shadow-casting geom is kept while the capsule swept by its sphere along a casting directional light, down to
+    the floor (z = 0, below which nothing is drawn), reaches into the view: a shadow it casts falls within it.
+    Planes (unbounded) are always kept; so is every geom when the camera is not a plain perspective one, or when a
+    light that is not directional casts shadows. The near plane culls; the far plane does not.
+    """
+    keep = np.zeros(model.ngeom, dtype=bool)
+    casting = model.light_castshadow.astype(bool) & model.light_active.astype(bool)
+    if (model.cam_projection[camera_id] != mujoco.mjtProjection.mjPROJ_PERSPECTIVE
+            or model.cam_sensorsize[camera_id].any()
+            or (model.light_type[casting] != mujoco.mjtLightType.mjLIGHT_DIRECTIONAL).any()):
+        return keep
+    planes = _frustum_planes(model, data, camera_id, aspect)
+    centres, radii = data.geom_xpos, model.geom_rbound
+    outside = _outside(planes, centres, radii)
+    hidden = outside.any(axis=1)
+    casts = model.geom_castshadow.astype(bool)
+    for direction in data.light_xdir[casting]:
+        if direction[2] >= 0:  # lit from below the horizon: any geom might shadow the view
+            return keep
+        reach = (np.maximum(centres[:, 2], 0.0) + radii) / -direction[2]
+        swept_out = (outside & _outside(planes, centres + reach[:, None] * direction, radii)).any(axis=1)
+        hidden &= ~casts | swept_out
+    return hidden & (radii > 0)
+
+
+def _frustum_planes(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspect: float) -> np.ndarray:
+    """(5, 4) planes (unit outward normal, offset) of the camera's view: left, right, bottom, top, near."""
+    position = data.cam_xpos[camera_id]
+    right, up, back = data.cam_xmat[camera_id].reshape(3, 3).T  # MuJoCo cameras look along their -z
+    tan_y = np.tan(np.radians(model.cam_fovy[camera_id]) / 2)
+    tan_x = tan_y * aspect
+    normals = np.array([-right + tan_x * back, right + tan_x * back, -up + tan_y * back, up + tan_y * back, back])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    offsets = -normals @ position
+    offsets[4] += model.vis.map.znear * model.stat.extent  # the near plane lies znear in front of the camera
+    return np.column_stack([normals, offsets])
+
+
+def _outside(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """(n, 5) bool: whether each sphere lies wholly outside each plane."""
+    return centres @ planes[:, :3].T + planes[:, 3] > radii[:, None]
+
+
+@contextmanager
+def _left_out(model: mujoco.MjModel, geoms: np.ndarray):
+    """While open, MuJoCo's scene update skips `geoms` ((ngeom,) bool): it leaves out geoms of alpha 0."""
+    alpha = model.geom_rgba[geoms, 3].copy()
+    model.geom_rgba[geoms, 3] = 0.0
+    try:
+        yield
+    finally:
+        model.geom_rgba[geoms, 3] = alpha
