@@ -46,7 +46,7 @@ KEY_LIGHT_DIR = (-0.342, -0.321, -0.883)
 KEY_LIGHT_INTENSITY = 2000.0
 KEY_DIFFUSE_AT_REFERENCE = 0.5  # diffuse gain that gives the reference's lit/shadowed contrast at intensity 2000
 KEY_SPECULAR_AT_REFERENCE = 0.6
-SHADOW_MAP_PX = 1024  # the key light's shadow map, when shadows are on
+SHADOW_MAP_PX = 512  # the key light's shadow map (texels a side)
 # The square (m, across the light's beam) that the shadow map covers, centred where the key light's line meets
 # the workspace: the table top in front of the robot, with the robot's shoulders and the arms' reach
 SHADOW_CENTRE = (0.5, 0.0, TABLE_TOP_Z)

@@ -1,9 +1,12 @@
 """`--env.type=tavis` as LeRobot uses it: registry, features, create_envs (sync and forkserver async), seeds."""
 
+import json
 import os
+from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
+import draccus
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -237,3 +240,26 @@ def test_an_explicit_episode_log_wins_and_without_either_there_is_none(tmp_path,
     monkeypatch.setattr("sys.argv", ["lerobot-eval", "--env.type=tavis"])
     assert _episode_log_of(TavisEnvConfig(task="wait_then_act")) is None
     assert "no episode log" in caplog.text and "--env.episode_log" in caplog.text
+
+
+@dataclass
+class _Cli:
+    env: EnvConfig
+
+
+@pytest.mark.parametrize("args,shadows", [([], True), (["--env.shadows=false"], False)])
+def test_shadows_are_on_unless_the_command_line_turns_them_off_and_the_log_says_which(tmp_path, args, shadows):
+    config = draccus.parse(_Cli, args=["--env.type=tavis", "--env.task=wait_then_act", "--env.camera_mode=fixed_only",
+                                       "--env.image_size=[16,16]", "--env.episode_length_s=0.1",
+                                       f"--env.episode_log={tmp_path / 'episodes.jsonl'}", *args]).env
+    assert config.shadows is shadows
+    vec = config.create_envs(n_envs=1)["tavis_head"][0]
+    vec.reset(seed=[0], options={NEW_ROLLOUT_OPTION: True})
+    assert vec.envs[0].unwrapped.shadows is shadows
+    model = vec.envs[0].unwrapped.model
+    assert bool(model.light_castshadow.any()) is shadows
+    for _ in range(2):
+        vec.step(canonical.rest_action()[None])
+    vec.close()
+    (record,) = [json.loads(line) for line in (tmp_path / "episodes.jsonl").read_text().splitlines()]
+    assert record["shadows"] is shadows
