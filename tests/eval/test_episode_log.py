@@ -95,7 +95,7 @@ def test_the_log_writes_the_fields_of_every_metric_in_registry_order(tmp_path):
     log = tmp_path / "episodes.jsonl"
     info = _run(EpisodeLogger(ScriptedEnv(actions), log, "tavis_head", 0), 0, len(actions))
     (record,) = [json.loads(line) for line in log.read_text().splitlines()]
-    assert list(record) == ["robot", "suite", "task", "task_id", "split", "camera_mode", "seed", "success",
-                            "length_steps", "prompt", "conditions", "reach", *GALT.fields, *WRIST_LEAD.fields,
+    assert list(record) == ["robot", "suite", "task", "task_id", "split", "camera_mode", "shadows", "seed",
+                            "success", "length_steps", "prompt", "conditions", "reach", *GALT.fields, *WRIST_LEAD.fields,
                             "instability"]
     assert all(info[field] == record[field] for field in GALT.fields + WRIST_LEAD.fields)
