@@ -98,10 +98,15 @@ def use_look(spec: mujoco.MjSpec, geom: mujoco.MjsGeom, look: Look) -> None:
     geom.material = material
 
 
+SKY_RGB = ((0.91, 0.91, 0.92), (0.80, 0.80, 0.82))  # the backdrop's gradient, top to horizon
+
+
 def add_sky(spec: mujoco.MjSpec) -> None:
-    """A plain light-grey backdrop, so cameras looking above the table do not see black."""
+    """A plain light-grey backdrop, so cameras looking above the table do not see black; what lies beyond a wrist
+    camera's far clip is drawn in its mean colour (`physics.WRIST_FAR_CLIP_M`)."""
     spec.add_texture(name="sky", type=mujoco.mjtTexture.mjTEXTURE_SKYBOX, builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
-                     rgb1=(0.91, 0.91, 0.92), rgb2=(0.80, 0.80, 0.82), width=64, height=64)
+                     rgb1=SKY_RGB[0], rgb2=SKY_RGB[1], width=64, height=64)
+    spec.visual.rgba.fog = (*np.mean(SKY_RGB, axis=0), 1.0)
 
 
 def add_floor(spec: mujoco.MjSpec) -> None:

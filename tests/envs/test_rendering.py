@@ -1,11 +1,12 @@
 """CameraRig: each image leaves out the geoms that can neither show in it nor shadow what does, and its pixels are
-those of drawing everything."""
+those of drawing everything; the wrist cameras see nothing beyond their far clip."""
 
 import mujoco
 import numpy as np
 import pytest
 
 from lerobot_tavis import canonical
+from lerobot_tavis.envs import physics
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.rendering import CameraRig, out_of_view
 from tests.conftest import run_steps
@@ -37,6 +38,7 @@ def test_leaving_geoms_out_changes_no_pixel(task, robot, shadows):
             camera = env.world.cameras[name]
             left_out += out_of_view(env.model, env.data, camera, SIZE[1] / SIZE[0]).sum()
             everything.update_scene(env.data, camera=camera)
+            everything.scene.flags[mujoco.mjtRndFlag.mjRND_FOG] = name.endswith("wrist")  # the wrists' far clip
             np.testing.assert_array_equal(rig.render_camera(env.data, camera), everything.render(), err_msg=name)
     np.testing.assert_array_equal(env.model.geom_rgba, rgba)  # the model is left as it was
     assert left_out > 0
@@ -64,4 +66,26 @@ def test_a_wrist_camera_leaves_out_most_of_the_robot_but_not_what_shadows_its_vi
     assert out_of_view(model, data, head_view, SIZE[1] / SIZE[0])[can] == (not model.geom_castshadow[can])
     model.geom_castshadow[can] = 0
     assert out_of_view(model, data, head_view, SIZE[1] / SIZE[0])[can]
+    env.close()
+
+
+def test_a_wrist_camera_sees_the_backdrop_colour_beyond_its_far_clip():
+    env = TavisEnv("clutter_pick_cube", "reachy2", camera_mode="head_wrist", image_size=SIZE)
+    env.reset(seed=0)
+    _posed(env, 0.5, 0.1)
+    wrist = env.world.cameras["left_wrist"]
+    with mujoco.Renderer(env.model, *SIZE) as depth_renderer:
+        depth_renderer.enable_depth_rendering()
+        depth_renderer.update_scene(env.data, camera=wrist)
+        depth = depth_renderer.render()  # distance along the view (m)
+    image = env._sim.rig.render_camera(env.data, wrist).astype(int)
+    fog = np.round(255 * env.model.vis.rgba.fog[:3])
+    beyond, near = depth > physics.WRIST_FAR_CLIP_M + 0.01, depth < physics.WRIST_FAR_CLIP_M - 0.01
+    assert beyond.mean() > 0.05 and near.mean() > 0.05
+    assert np.abs(image[beyond] - fog).max() <= 1
+    assert (np.abs(image[near] - fog).max(axis=1) > 8).mean() > 0.5  # the nearer scene shows as it is
+    head = env.world.cameras["head"]  # the head camera has no such clip
+    with mujoco.Renderer(env.model, *SIZE) as plain:
+        plain.update_scene(env.data, camera=head)
+        np.testing.assert_array_equal(env._sim.rig.render_camera(env.data, head), plain.render())
     env.close()
