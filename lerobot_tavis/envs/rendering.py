@@ -88,12 +88,12 @@ def out_of_view(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspe
     Planes (unbounded) are always kept; so is every geom when the camera is not a plain perspective one, or when a
     light that is not directional casts shadows. The near plane culls; MuJoCo's far plane does not.
     """
-    keep = np.zeros(model.ngeom, dtype=bool)
+    none = np.zeros(model.ngeom, dtype=bool)
     casting = model.light_castshadow.astype(bool) & model.light_active.astype(bool)
     if (model.cam_projection[camera_id] != mujoco.mjtProjection.mjPROJ_PERSPECTIVE
             or model.cam_sensorsize[camera_id].any()
             or (model.light_type[casting] != mujoco.mjtLightType.mjLIGHT_DIRECTIONAL).any()):
-        return keep
+        return none
     planes = _frustum_planes(model, data, camera_id, aspect, far_m)
     centres, radii = data.geom_xpos, model.geom_rbound
     outside = _outside(planes, centres, radii)
@@ -101,7 +101,7 @@ def out_of_view(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspe
     casts = model.geom_castshadow.astype(bool)
     for direction in data.light_xdir[casting]:
         if direction[2] >= 0:  # lit from below the horizon: any geom might shadow the view
-            return keep
+            return none
         reach = (np.maximum(centres[:, 2], 0.0) + radii) / -direction[2]
         swept_out = (outside & _outside(planes, centres + reach[:, None] * direction, radii)).any(axis=1)
         hidden &= ~casts | swept_out
