@@ -1,13 +1,15 @@
 """Policy steps per second of TavisEnv with rendering, per robot x camera mode x image size, and the render cost.
 
-    python benchmarks/env_speed.py [--steps 200] [--robots gr1t2 reachy2] [--shadows] [--repeats 3]
-                                   [--peer-python /path/to/python-with-gym-aloha]
+    python benchmarks/env_speed.py [--steps 200] [--robots gr1t2 reachy2] [--configs head_only:240x320 ...]
+                                   [--shadows] [--repeats 3] [--peer-python /path/to/python-with-gym-aloha]
 
 Each configuration runs in a fresh process (one GL context, like one vector-env worker): reset, 10 warm-up
 steps, then `--steps` timed steps of a scripted head-and-arm motion, then 50 timed renders of the mode's cameras
-alone (the render cost per frame, milliseconds per camera image). `--shadows` measures every configuration without
-and with the key light's shadows. With `--repeats`, the configurations are measured round-robin that many times
-and the medians reported, so a change of machine load hits all of them alike.
+alone (the render cost per frame, milliseconds per camera image). Configurations render with shadows (the env's
+default); `--shadows` measures every configuration without and with them. With `--repeats`, the configurations are
+measured round-robin that many times and the medians (and best rates) reported, so a change of machine load hits
+all of them alike. Besides wall-clock rates, each step's CPU time (all of the process's threads, Mesa's rendering
+threads included) is reported: on a shared machine it moves less with other load than the rate does.
 
 The peer is LeRobot's gym-aloha (`AlohaInsertion-v0`, `pixels_agent_pos`: one 480x640 camera image per step plus
 the joint state), measured in the same rounds when it imports in `--peer-python` (default: this interpreter).
@@ -25,7 +27,7 @@ import subprocess
 import sys
 import time
 
-CONFIGS = [(mode, size) for mode in ("head_only", "head_wrist") for size in ((240, 320), (480, 640))]
+CONFIGS = [f"{mode}:{size}" for mode in ("head_only", "head_wrist") for size in ("240x320", "480x640")]
 WARM_UP_STEPS = 10
 RENDER_REPEATS = 50
 
@@ -53,10 +55,11 @@ def measure(robot: str, camera_mode: str, size: tuple[int, int], steps: int, sha
 
     for k in range(WARM_UP_STEPS):
         env.step(action(k))
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     for k in range(steps):
         env.step(action(k))
     steps_per_s = steps / (time.perf_counter() - t0)
+    cpu_ms = (time.process_time() - cpu0) * 1000 / steps
 
     rig = CameraRig(env.model, {name: env.world.cameras[name] for name in env.camera_names}, size)
     rig.render(env.data)
@@ -66,7 +69,7 @@ def measure(robot: str, camera_mode: str, size: tuple[int, int], steps: int, sha
     render_ms = (time.perf_counter() - t0) * 1000 / (RENDER_REPEATS * len(env.camera_names))
     rig.close()
     env.close()
-    return {"steps_per_s": steps_per_s, "reset_s": reset_s, "render_ms": render_ms}
+    return {"steps_per_s": steps_per_s, "cpu_ms": cpu_ms, "reset_s": reset_s, "render_ms": render_ms}
 
 
 def measure_aloha(steps: int) -> dict:
@@ -80,12 +83,13 @@ def measure_aloha(steps: int) -> dict:
     env.action_space.seed(0)
     for _ in range(WARM_UP_STEPS):
         env.step(env.action_space.sample())
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     for _ in range(steps):
         env.step(env.action_space.sample())
     steps_per_s = steps / (time.perf_counter() - t0)
+    cpu_ms = (time.process_time() - cpu0) * 1000 / steps
     env.close()
-    return {"steps_per_s": steps_per_s}
+    return {"steps_per_s": steps_per_s, "cpu_ms": cpu_ms}
 
 
 def _run(python: str, steps: int, *one: str) -> dict | None:
@@ -100,7 +104,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--steps", type=int, default=200)
     parser.add_argument("--robots", nargs="+", help="default: every built-in robot")
-    parser.add_argument("--shadows", action="store_true", help="also measure with shadows on")
+    parser.add_argument("--configs", nargs="+", default=CONFIGS, help="camera mode:HxW (default: %(default)s)")
+    parser.add_argument("--shadows", action="store_true", help="also measure without shadows")
     parser.add_argument("--repeats", type=int, default=1, help="round-robin rounds; medians are reported")
     parser.add_argument("--peer-python", default=sys.executable, help="interpreter in which gym_aloha imports")
     parser.add_argument("--one", nargs="+", help=argparse.SUPPRESS)
@@ -112,12 +117,17 @@ def main() -> None:
             robot, mode, h, w, shadows = args.one
             print(json.dumps(measure(robot, mode, (int(h), int(w)), args.steps, shadows == "on")))
         return
+    from lerobot_tavis.envs.robots import BUILTIN_ROBOTS  # not before: the peer's interpreter lacks the package
 
-    from lerobot_tavis.envs.robots import BUILTIN_ROBOTS
-
-    args.robots = args.robots or list(BUILTIN_ROBOTS)
-    configs = [(robot, mode, size, shadows) for robot in args.robots for mode, size in CONFIGS
-               for shadows in (("off", "on") if args.shadows else ("off",))]
+    sizes = {}
+    for config in args.configs:
+        mode, _, size = config.partition(":")
+        h, _, w = size.partition("x")
+        if not (mode in ("head_only", "head_wrist") and h.isdigit() and w.isdigit()):
+            parser.error(f"--configs: {config!r} is not head_only:HxW or head_wrist:HxW")
+        sizes[config] = (mode, (int(h), int(w)))
+    configs = [(robot, mode, size, shadows) for robot in args.robots or BUILTIN_ROBOTS for mode, size in sizes.values()
+               for shadows in (("off", "on") if args.shadows else ("on",))]
     results = {config: [] for config in configs}
     peer = []
     for _ in range(args.repeats):
@@ -128,30 +138,37 @@ def main() -> None:
                 raise SystemExit(f"measuring {config} failed: run it alone with --one {robot} {mode} {h} {w} {shadows}")
             results[config].append(measured)
         if (measured := _run(args.peer_python, args.steps, "aloha")) is not None:
-            peer.append(measured["steps_per_s"])
+            peer.append(measured)
 
     def median(config, key):
         return statistics.median(r[key] for r in results[config])
 
+    load = os.getloadavg()[0]
     print(f"machine: {platform.node()} {os.cpu_count()} cores, MUJOCO_GL={os.environ.get('MUJOCO_GL', 'egl')}, "
-          f"{args.repeats} round(s), medians")
-    print("| robot | camera mode | image (HxW) | cameras | shadows | steps/s | render (ms per image) | reset (s) |")
-    print("|---|---|---|---|---|---|---|---|")
+          f"{args.repeats} round(s), medians (best rate in brackets), load average {load:.1f} at the end")
+    print("| robot | camera mode | image (HxW) | cameras | shadows | steps/s | CPU ms per step "
+          "| render (ms per image) | reset (s) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for config in configs:
         robot, mode, (h, w), shadows = config
+        best = max(r["steps_per_s"] for r in results[config])
         print(f"| {robot} | {mode} | {h}x{w} | {1 if mode == 'head_only' else 3} | {shadows} "
-              f"| {median(config, 'steps_per_s'):.1f} | {median(config, 'render_ms'):.2f} "
-              f"| {median(config, 'reset_s'):.2f} |")
+              f"| {median(config, 'steps_per_s'):.1f} ({best:.1f}) | {median(config, 'cpu_ms'):.1f} "
+              f"| {median(config, 'render_ms'):.2f} | {median(config, 'reset_s'):.2f} |")
     if not peer:
         print(f"\npeer: gym_aloha does not import in {args.peer_python}; not measured")
         return
-    aloha = statistics.median(peer)
-    print(f"\npeer: gym-aloha AlohaInsertion-v0 (pixels_agent_pos) {aloha:.1f} steps/s")
+    aloha = statistics.median(p["steps_per_s"] for p in peer)
+    aloha_cpu = statistics.median(p["cpu_ms"] for p in peer)
+    print(f"\npeer: gym-aloha AlohaInsertion-v0 (pixels_agent_pos) {aloha:.1f} steps/s "
+          f"(best {max(p['steps_per_s'] for p in peer):.1f}), {aloha_cpu:.0f} CPU ms per step")
     for config in configs:
         robot, mode, (h, w), shadows = config
         if mode == "head_wrist" and (h, w) == (480, 640):
             ratio = median(config, "steps_per_s") / aloha
-            print(f"{robot} head_wrist 480x640 shadows {shadows}: {ratio:.1f}x the peer")
+            cpu_ratio = aloha_cpu / median(config, "cpu_ms")
+            print(f"{robot} head_wrist 480x640 shadows {shadows}: {ratio:.1f}x the peer's rate, "
+                  f"{cpu_ratio:.1f}x by CPU time")
 
 
 if __name__ == "__main__":

@@ -39,6 +39,7 @@ from lerobot_tavis.locking import exclusive_output
 
 CONVERSION_LOG = "meta/tavis_conversion.json"
 RAW_IMAGE_SIZE = (480, 640)  # (H, W) of the cameras rendered from raw episodes unless told otherwise
+RENDER_SHADOWS = True  # replayed episodes are rendered with the key light's shadows, as evaluation renders them
 
 
 class ReplayError(TavisError):
@@ -147,7 +148,8 @@ def _convert(cfg: ConvertConfig, progress: bool) -> Path:
             episodes.close()  # stops the workers at once when a replay or a write failed
             dataset.finalize()  # also on failure: an unfinalized dataset writes into the staging folder later
         log = {"raw_dir": str(Path(cfg.raw_dir).absolute()), "fps": cfg.fps, "stride": stride, "storage": cfg.storage,
-               "image_size": list(cfg.image_size), "cameras": list(cameras), "zero_neck": cfg.zero_neck,
+               "image_size": list(cfg.image_size), "shadows": RENDER_SHADOWS, "cameras": list(cameras),
+               "zero_neck": cfg.zero_neck,
                "episodes": [{"episode_index": i, "raw_file": e.file, "task": e.task, "seed": e.seed,
                              "max_qpos_deviation": deviations[e.file]} for i, e in enumerate(entries)]}
         (staging / CONVERSION_LOG).write_text(json.dumps(log, indent=1) + "\n")
@@ -254,7 +256,7 @@ class Replayer:
         key = (episode.robot, episode.task, episode.split)
         if key not in self._envs:
             self._envs[key] = TavisEnv(episode.task, episode.robot, split=episode.split, fps=episode.fps,
-                                       image_size=self.image_size, cameras=())
+                                       image_size=self.image_size, shadows=RENDER_SHADOWS, cameras=())
         return self._envs[key]
 
     def _rig(self, episode: RawEpisode, env):

@@ -59,6 +59,8 @@ class TavisEnvConfig(EnvConfig):
     image_size: tuple[int, int] = (480, 640)
     # Episode length in seconds (400 steps at 20 Hz by default)
     episode_length_s: float = 20.0
+    # The key light casts shadows, as in the reference; false renders without them (a little faster, other images)
+    shadows: bool = True
     # JSON-lines log of every finished episode (seed, success, GALT); default <output_dir>/episodes.jsonl when
     # --output_dir is on the command line, else none
     episode_log: str | None = None
@@ -102,7 +104,8 @@ class TavisEnvConfig(EnvConfig):
     @property
     def gym_kwargs(self) -> dict:
         return {"robot": self.robot, "camera_mode": self.camera_mode, "split": self.split,
-                "image_size": tuple(self.image_size), "episode_length_s": self.episode_length_s}
+                "image_size": tuple(self.image_size), "episode_length_s": self.episode_length_s,
+                "shadows": self.shadows}
 
     def sub_env_factories(self) -> dict[str, dict[int, partial]]:
         """One sub-env factory per task of `task`, by suite and the task's index in its whole suite (so a run of

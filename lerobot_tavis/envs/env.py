@@ -90,7 +90,7 @@ class TavisEnv(gym.Env):
 
     def __init__(self, task: str = "tabletop", robot: str = "gr1t2", camera_mode: str = DEFAULT_CAMERA_MODE,
                  split: str = "id", image_size: tuple[int, int] = (480, 640), episode_length_s: float = 20.0,
-                 shadows: bool = False, render_mode: str | None = "rgb_array", fps: int = physics.POLICY_HZ,
+                 shadows: bool = True, render_mode: str | None = "rgb_array", fps: int = physics.POLICY_HZ,
                  cameras: tuple[str, ...] | None = None):
         info = task_info(task)
         camera_mode = resolve_camera_mode(camera_mode)

@@ -15,7 +15,7 @@ EPISODE_LOG_NAME = "episodes.jsonl"  # the episode log's file name in an evaluat
 
 def make_tavis_env(task: str, robot: str, camera_mode: str, split: str, image_size: tuple[int, int],
                    episode_length_s: float, episode_log: str | None = None, suite: str = "",
-                   task_id: int = 0, cameras: tuple[str, ...] | None = None) -> gym.Env:
+                   task_id: int = 0, cameras: tuple[str, ...] | None = None, shadows: bool = True) -> gym.Env:
     """One sub-env (picklable through functools.partial for forkserver workers). In a worker process it also
     binds the worker's life to its parent's, so an env worker never outlives a killed lerobot-eval or tavis eval."""
     from lerobot_tavis.envs.env import TavisEnv  # imports MuJoCo: only in the process that simulates
@@ -24,7 +24,7 @@ def make_tavis_env(task: str, robot: str, camera_mode: str, split: str, image_si
     bind_worker_to_parent()
 
     env = TavisEnv(task, robot, camera_mode=camera_mode, split=split, image_size=tuple(image_size),
-                   episode_length_s=episode_length_s, cameras=cameras)
+                   episode_length_s=episode_length_s, cameras=cameras, shadows=shadows)
     if episode_log:
         from lerobot_tavis.eval.episode_log import EpisodeLogger
 

@@ -16,6 +16,7 @@ import warnings
 from lerobot_tavis.errors import FieldError
 
 CAMERA_NAMES = ("head", "fixed", "left_wrist", "right_wrist")
+WRIST_CAMERAS = ("left_wrist", "right_wrist")  # the cameras on the hands
 # Cameras for people (gallery, videos), never part of a camera mode's observation.
 OVERVIEW_CAMERA = "overview"
 VIEW_CAMERAS = (OVERVIEW_CAMERA,)

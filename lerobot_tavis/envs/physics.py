@@ -17,6 +17,10 @@ TICKS_PER_STEP = CONTROL_HZ // POLICY_HZ  # 3 ticks per 20 Hz policy step
 # Clip planes of every camera (m). The reference clips its fixed and wrist cameras at 0.1 m (its head camera at
 # 0.15 m), so a head pitched down in front of the fixed camera is cut away instead of filling its view.
 NEAR_CLIP_M, FAR_CLIP_M = 0.10, 20.0
+# The reference's wrist cameras see nothing beyond 1 m. MuJoCo's clip planes are global, and a wrist camera's own far
+# plane would also cut its shadow map (drawn between the same planes), so the wrist cameras draw what lies beyond
+# in the backdrop's colour instead: a fog that starts and ends there (`rendering.CameraRig`).
+WRIST_FAR_CLIP_M = 1.0
 
 CONTACT_SOLREF = (0.01, 1.0)
 CONTACT_SOLIMP = (0.95, 0.99, 0.001, 0.5, 2.0)
@@ -58,10 +62,13 @@ def configure(spec: mujoco.MjSpec, *, image_size: tuple[int, int]) -> None:
 
 
 def set_clip_planes(model: mujoco.MjModel) -> None:
-    """Clip every camera's view to NEAR_CLIP_M..FAR_CLIP_M metres (MuJoCo's clip planes are global and stored
-    relative to the compiled model's extent, so this runs after compiling)."""
+    """Clip every camera's view to NEAR_CLIP_M..FAR_CLIP_M metres, and set the fog that ends the wrist cameras' view
+    at WRIST_FAR_CLIP_M (MuJoCo stores both relative to the compiled model's extent, so this runs after
+    compiling). The fog's colour is the model's `visual.rgba.fog`."""
     model.vis.map.znear = NEAR_CLIP_M / model.stat.extent
     model.vis.map.zfar = FAR_CLIP_M / model.stat.extent
+    model.vis.map.fogstart = WRIST_FAR_CLIP_M / model.stat.extent
+    model.vis.map.fogend = (WRIST_FAR_CLIP_M + 0.001) / model.stat.extent  # a 1 mm step: all or nothing
 
 
 def style_geom(geom: mujoco.MjsGeom, role: dict[str, int], rgba=None, *, group: int = GROUP_VISIBLE) -> None:

@@ -1,12 +1,20 @@
-"""Offscreen rendering of a camera subset with one MuJoCo renderer (one GL context per env)."""
+"""Offscreen rendering of a camera subset with one MuJoCo renderer (one GL context per env).
+
+Each image draws only the geoms that can show in it or shadow what does (`out_of_view`): MuJoCo draws every geom in
+every pass, and with shadows each image takes three (the lit scene, the shadow map, the shadowed light), so a
+camera that sees a part of the scene saves most of its cost. The pixels are those of drawing everything.
+"""
 
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 
 import mujoco
 import numpy as np
 
+from lerobot_tavis.envs import physics
+from lerobot_tavis.envs.modes import WRIST_CAMERAS
 from lerobot_tavis.errors import TavisError
 
 
@@ -15,7 +23,9 @@ class NoOpenGLError(TavisError, RuntimeError):
 
 
 class CameraRig:
-    """Renders the named cameras of a model at one image size; `blacked_out` cameras yield black frames unrendered."""
+    """Renders the named cameras of a model at one image size; `blacked_out` cameras yield black frames unrendered.
+    Wrist cameras (model camera names ending in one of WRIST_CAMERAS) see nothing beyond physics.WRIST_FAR_CLIP_M:
+    the model's fog (`physics.set_clip_planes`) paints it over."""
 
     def __init__(self, model: mujoco.MjModel, cameras: dict[str, int], image_size: tuple[int, int],
                  blacked_out: frozenset[str] = frozenset()):
@@ -24,6 +34,7 @@ class CameraRig:
         self.blacked_out = blacked_out
         self._model = model
         self._renderer = None
+        self._wrists = {camera for camera in range(model.ncam) if model.camera(camera).name.endswith(WRIST_CAMERAS)}
         if set(cameras) - set(blacked_out):
             self._ensure_renderer()  # else nothing to draw: no GL context until `render_camera` needs one
 
@@ -40,7 +51,12 @@ class CameraRig:
     def render_camera(self, data: mujoco.MjData, camera_id: int) -> np.ndarray:
         """One (H, W, 3) uint8 image from any camera of the model, e.g. one outside the rig for a video."""
         renderer = self._ensure_renderer()
-        renderer.update_scene(data, camera=camera_id)
+        wrist = camera_id in self._wrists
+        unseen = out_of_view(self._model, data, camera_id, self.width / self.height,
+                             far_m=physics.WRIST_FAR_CLIP_M if wrist else None)
+        with _left_out(self._model, unseen):
+            renderer.update_scene(data, camera=camera_id)
+        renderer.scene.flags[mujoco.mjtRndFlag.mjRND_FOG] = wrist
         return renderer.render()
 
     def _ensure_renderer(self) -> mujoco.Renderer:
@@ -59,3 +75,68 @@ class CameraRig:
     def close(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
+
+
+def out_of_view(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspect: float,
+                far_m: float | None = None) -> np.ndarray:
+    """(ngeom,) bool: the geoms that can neither appear in the image of camera `camera_id` (`aspect` = width /
+    height) nor shadow anything that does, judged by their bounding spheres (`geom_rbound`). With `far_m`, what lies
+    farther than `far_m` (m, along the view) counts as unseen too (a wrist camera's fog covers it).
+
+    A shadow-casting geom is kept while the capsule swept by its sphere along a casting directional light, down to
+    the floor (z = 0, below which nothing is drawn), reaches into the view: a shadow it casts falls within it.
+    Planes (unbounded) are always kept; so is every geom when the camera is not a plain perspective one, or when a
+    light that is not directional casts shadows. The near plane culls; MuJoCo's far plane does not.
+    """
+    none = np.zeros(model.ngeom, dtype=bool)
+    casting = model.light_castshadow.astype(bool) & model.light_active.astype(bool)
+    if (model.cam_projection[camera_id] != mujoco.mjtProjection.mjPROJ_PERSPECTIVE
+            or model.cam_sensorsize[camera_id].any()
+            or (model.light_type[casting] != mujoco.mjtLightType.mjLIGHT_DIRECTIONAL).any()):
+        return none
+    planes = _frustum_planes(model, data, camera_id, aspect, far_m)
+    centres, radii = data.geom_xpos, model.geom_rbound
+    outside = _outside(planes, centres, radii)
+    hidden = outside.any(axis=1)
+    casts = model.geom_castshadow.astype(bool)
+    for direction in data.light_xdir[casting]:
+        if direction[2] >= 0:  # lit from below the horizon: any geom might shadow the view
+            return none
+        reach = (np.maximum(centres[:, 2], 0.0) + radii) / -direction[2]
+        swept_out = (outside & _outside(planes, centres + reach[:, None] * direction, radii)).any(axis=1)
+        hidden &= ~casts | swept_out
+    return hidden & (radii > 0)
+
+
+def _frustum_planes(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspect: float,
+                    far_m: float | None) -> np.ndarray:
+    """(5 or 6, 4) planes (unit outward normal, offset) of the camera's view: left, right, bottom, top, near and,
+    with `far_m`, far."""
+    position = data.cam_xpos[camera_id]
+    right, up, back = data.cam_xmat[camera_id].reshape(3, 3).T  # MuJoCo cameras look along their -z
+    tan_y = np.tan(np.radians(model.cam_fovy[camera_id]) / 2)
+    tan_x = tan_y * aspect
+    normals = np.array([-right + tan_x * back, right + tan_x * back, -up + tan_y * back, up + tan_y * back, back])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    offsets = -normals @ position
+    offsets[4] += model.vis.map.znear * model.stat.extent  # the near plane lies znear in front of the camera
+    planes = np.column_stack([normals, offsets])
+    if far_m is None:
+        return planes
+    return np.vstack([planes, [*-back, back @ position - far_m]])
+
+
+def _outside(planes: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """(n, planes) bool: whether each sphere lies wholly outside each plane."""
+    return centres @ planes[:, :3].T + planes[:, 3] > radii[:, None]
+
+
+@contextmanager
+def _left_out(model: mujoco.MjModel, geoms: np.ndarray):
+    """While open, MuJoCo's scene update skips `geoms` ((ngeom,) bool): it leaves out geoms of alpha 0."""
+    alpha = model.geom_rgba[geoms, 3].copy()
+    model.geom_rgba[geoms, 3] = 0.0
+    try:
+        yield
+    finally:
+        model.geom_rgba[geoms, 3] = alpha

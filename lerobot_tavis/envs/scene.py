@@ -4,8 +4,15 @@ materials ("looks") that the arena and the tasks' props are drawn with.
 World frame: x forward from the robot, y to its left, z up, floor at z = 0, table top at z = 1.0.
 
 Lighting follows the reference (§1.4): a white dome (here the headlight's ambient and a soft camera fill) plus one
-distant key light from the front-left, above. MuJoCo's fixed-function lights have no physical units, so the
-reference's intensities only set ratios: `set_key_light` scales the key light by intensity / 2000.
+distant key light from the front-left, above, which casts the scene's shadows (on by default, as in the reference).
+MuJoCo's fixed-function lights have no physical units, so the reference's intensities only set ratios:
+`set_key_light` scales the key light by intensity / 2000.
+
+Shadows cost a depth pass from the light and a second lit pass per rendered image, so they are kept cheap: one
+shadow-casting light, a SHADOW_MAP_PX map spent on a square SHADOW_HALF_WIDTH_M around SHADOW_CENTRE (the light is
+placed on the line through it), and only what can shadow the workspace casts: the robot, the props and the task's
+own scenery, not the arena (floor, table, backdrop). `rendering.CameraRig` also leaves out of each image the geoms
+that can neither appear in it nor shadow what does.
 """
 
 from __future__ import annotations
@@ -39,7 +46,12 @@ KEY_LIGHT_DIR = (-0.342, -0.321, -0.883)
 KEY_LIGHT_INTENSITY = 2000.0
 KEY_DIFFUSE_AT_REFERENCE = 0.5  # diffuse gain that gives the reference's lit/shadowed contrast at intensity 2000
 KEY_SPECULAR_AT_REFERENCE = 0.6
-SHADOW_MAP_PX = 1024  # the key light's shadow map, when shadows are on
+SHADOW_MAP_PX = 512  # the key light's shadow map (texels a side)
+# The square (m, across the light's beam) that the shadow map covers, centred where the key light's line meets
+# the workspace: the table top in front of the robot, with the robot's shoulders and the arms' reach
+SHADOW_CENTRE = (0.5, 0.0, TABLE_TOP_Z)
+SHADOW_HALF_WIDTH_M = 1.0
+KEY_LIGHT_DISTANCE_M = 3.0  # from SHADOW_CENTRE back along the light: above everything that casts
 DOME_AMBIENT = 0.5  # the headlight's ambient, grey
 
 
@@ -86,10 +98,15 @@ def use_look(spec: mujoco.MjSpec, geom: mujoco.MjsGeom, look: Look) -> None:
     geom.material = material
 
 
+SKY_RGB = ((0.91, 0.91, 0.92), (0.80, 0.80, 0.82))  # the backdrop's gradient, top to horizon
+
+
 def add_sky(spec: mujoco.MjSpec) -> None:
-    """A plain light-grey backdrop, so cameras looking above the table do not see black."""
+    """A plain light-grey backdrop, so cameras looking above the table do not see black; what lies beyond a wrist
+    camera's far clip is drawn in its mean colour (`physics.WRIST_FAR_CLIP_M`)."""
     spec.add_texture(name="sky", type=mujoco.mjtTexture.mjTEXTURE_SKYBOX, builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
-                     rgb1=(0.91, 0.91, 0.92), rgb2=(0.80, 0.80, 0.82), width=64, height=64)
+                     rgb1=SKY_RGB[0], rgb2=SKY_RGB[1], width=64, height=64)
+    spec.visual.rgba.fog = (*np.mean(SKY_RGB, axis=0), 1.0)
 
 
 def add_floor(spec: mujoco.MjSpec) -> None:
@@ -135,18 +152,13 @@ def add_table(spec: mujoco.MjSpec) -> None:
 
 
 def add_lights(spec: mujoco.MjSpec, *, shadows: bool) -> None:
-    """The dome (headlight ambient plus a weak fill from the camera) and the distant key light.
-
-    Only the key light can cast shadows, and they are opt-in: on a 2-core CPU (llvmpipe) they cut head_only 240x320
-    from about 140 to about 30 policy steps/s (`benchmarks/env_speed.py --shadows`); a 512 px shadow map is no
-    cheaper than 1024, the cost being MuJoCo's extra lit pass over the frame.
-    """
+    """The dome (headlight ambient plus a weak fill from the camera) and the distant key light, the one light that
+    casts shadows (when `shadows`)."""
     spec.visual.headlight.ambient = (DOME_AMBIENT,) * 3
     spec.visual.headlight.diffuse = (0.15, 0.15, 0.15)
     spec.visual.headlight.specular = (0.0, 0.0, 0.0)
     spec.visual.quality.shadowsize = SHADOW_MAP_PX
     key = spec.worldbody.add_light(name=KEY_LIGHT, type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
-    key.pos = (1.0, 1.0, 3.0)
     key.castshadow = shadows
     set_key_light(spec, KEY_LIGHT_DIR, KEY_LIGHT_INTENSITY)
 
@@ -160,9 +172,22 @@ def set_key_light(spec: mujoco.MjSpec, direction, intensity: float) -> None:
     if key is None:
         raise ValueError(f"the spec has no {KEY_LIGHT!r}: call add_arena first")
     key.dir = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
+    key.pos = key_light_pos(key.dir)
     gain = intensity / KEY_LIGHT_INTENSITY
     key.diffuse = (KEY_DIFFUSE_AT_REFERENCE * gain,) * 3
     key.specular = (KEY_SPECULAR_AT_REFERENCE * gain,) * 3
+
+
+def key_light_pos(direction) -> np.ndarray:
+    """Where a directional key light travelling along `direction` (world, unit) sits: KEY_LIGHT_DISTANCE_M back from
+    SHADOW_CENTRE. A directional light's position only places its shadow map, which MuJoCo centres on this line."""
+    return np.asarray(SHADOW_CENTRE) - KEY_LIGHT_DISTANCE_M * np.asarray(direction, dtype=float)
+
+
+def fit_shadow_map(model: mujoco.MjModel) -> None:
+    """Spend the shadow map on SHADOW_HALF_WIDTH_M around SHADOW_CENTRE (MuJoCo stores the half-width relative to
+    the compiled model's extent, so this runs after compiling)."""
+    model.vis.map.shadowclip = SHADOW_HALF_WIDTH_M / model.stat.extent
 
 
 def add_fixed_camera(spec: mujoco.MjSpec) -> None:
@@ -186,11 +211,15 @@ def add_overview_camera(spec: mujoco.MjSpec) -> None:
                               quat=camera_quat(forward, up=(0.0, 0.0, 1.0)), fovy=42.0)
 
 
-def add_arena(spec: mujoco.MjSpec, *, table: bool = True, shadows: bool = False) -> None:
+def add_arena(spec: mujoco.MjSpec, *, table: bool = True, shadows: bool = True) -> None:
+    """The arena on an empty `spec`; with `shadows`, the key light casts them. The arena's own geoms cast none:
+    their shadows would fall on the floor under the table, and the table's area would fill the shadow map."""
     add_sky(spec)
     add_floor(spec)
     if table:
         add_table(spec)
+    for geom in spec.geoms:
+        geom.castshadow = False
     add_lights(spec, shadows=shadows)
     add_fixed_camera(spec)
     add_overview_camera(spec)

@@ -171,6 +171,7 @@ def _restore_id_look(model: mujoco.MjModel, id_look: IdLook) -> None:
         model.geom_group[model.geom(f"{PREFIX}distractor{index}").id] = physics.GROUP_PARKED
     key = model.light(scene.KEY_LIGHT).id
     model.light_dir[key] = id_look.key_light_dir
+    model.light_pos[key] = scene.key_light_pos(id_look.key_light_dir)
     model.light_diffuse[key] = id_look.key_light_diffuse
     model.vis.headlight.ambient[:] = scene.DOME_AMBIENT
 
@@ -187,6 +188,7 @@ def _light(model: mujoco.MjModel, rng: np.random.Generator, id_look: IdLook) -> 
     direction = np.array([np.cos(down) * np.cos(heading), np.cos(down) * np.sin(heading), -np.sin(down)])
     key = model.light(scene.KEY_LIGHT).id
     model.light_dir[key] = direction
+    model.light_pos[key] = scene.key_light_pos(direction)  # keeps the shadow map on the workspace
     model.light_diffuse[key] = np.clip(id_look.key_light_diffuse * scale * kelvin_rgb(kelvin), 0.0, 1.0)
     model.vis.headlight.ambient[:] = ambient
     return {"light_azimuth_deg": float(azimuth), "light_elevation_deg": float(elevation),

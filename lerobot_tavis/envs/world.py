@@ -37,7 +37,7 @@ class World:
     robot_joint_qpos: np.ndarray  # qpos addresses of Robot.joint_names(), in that order
 
 
-def build_world(robot: Robot, task: Task, *, image_size: tuple[int, int], shadows: bool = False,
+def build_world(robot: Robot, task: Task, *, image_size: tuple[int, int], shadows: bool = True,
                 visual_variation: bool = False) -> World:
     """The compiled world of `task` on `robot`; `visual_variation` adds what the ood_visual split varies."""
     spec = mujoco.MjSpec()
@@ -52,6 +52,7 @@ def build_world(robot: Robot, task: Task, *, image_size: tuple[int, int], shadow
     del spec
     release_compiler_memory()
     physics.set_clip_planes(model)
+    scene.fit_shadow_map(model)
     task.bind(model)
     return index_world(model, robot)
 

@@ -61,7 +61,8 @@ class EpisodeLogger(gym.Wrapper):
         env = self.env.unwrapped
         return {
             "robot": env.robot_name, "suite": self.suite, "task": env.task, "task_id": self.task_id,
-            "split": env.split, "camera_mode": env.camera_mode, "seed": self._seed, "success": success,
+            "split": env.split, "camera_mode": env.camera_mode, "shadows": env.shadows, "seed": self._seed,
+            "success": success,
             "length_steps": len(self._actions), "prompt": env.task_description,
         }
 

@@ -129,13 +129,13 @@ multiprocessing.util.Finalize(None, close_kept_envs, exitpriority=10)
 def _env_batches(cfg, keep_workers: bool) -> tuple[dict, bool]:
     """make_env's batches for `cfg`, and whether they are kept for a next run. With `keep_workers`, a one-task async
     batch stays started after the run, and the next run with the same robot, camera mode, image size, episode length,
-    batch size and worker niceness retargets its workers to its own task and split instead of starting new ones:
-    32 env workers with three cameras took 25-33 s to start beside two other jobs' on a 16-CPU share of a GPU
+    shadows, batch size and worker niceness retargets its workers to its own task and split instead of starting new
+    ones: 32 env workers with three cameras took 25-33 s to start beside two other jobs' on a 16-CPU share of a GPU
     machine, the GPU idle meanwhile (docs/benchmarks.md)."""
     from lerobot.envs import make_env
 
     env = cfg.env
-    key = (env.robot, env.camera_mode, tuple(env.image_size), env.episode_length_s, env.worker_niceness,
+    key = (env.robot, env.camera_mode, tuple(env.image_size), env.episode_length_s, env.shadows, env.worker_niceness,
            cfg.eval.batch_size)
     if keep_workers and key in _KEPT:
         factories = [(suite, task_id, factory)

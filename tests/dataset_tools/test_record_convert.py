@@ -122,6 +122,7 @@ def test_frames_pair_each_observation_with_the_last_command_of_its_interval(data
     assert float(dataset[blocked_start][image_key("head")].max()) < 0.05  # the head camera is black there
     log = json.loads((dataset.root / "meta" / "tavis_conversion.json").read_text())
     assert [e["max_qpos_deviation"] for e in log["episodes"]] == [0.0] * 6  # exact replay
+    assert log["shadows"] is True  # rendered as evaluation renders by default
 
 
 def test_convert_prints_its_progress_and_no_encoder_chatter(raw_dir, tmp_path):

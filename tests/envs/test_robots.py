@@ -98,3 +98,17 @@ def test_rest_calibration_holds_the_rest_pose_exactly(name):
         quat = np.empty(4)
         mujoco.mju_mat2Quat(quat, data.site_xmat[site])
         assert quat_angle_rad(quat, rest[arm.quaternion]) < 1e-3
+
+
+def test_the_references_default_joints_would_put_reachy2s_wrists_under_the_table_top():
+    """Why Reachy2 starts from its own rest posture (docs/robots.md): the reference's default arm joints (shoulder
+    pitch -0.3, elbow -1.7, the rest 0) hold our wrist centres 0.15 m below the table top, over the table."""
+    robot, model, data = _compiled("reachy2")
+    reference = {"shoulder_pitch": -0.3, "elbow_pitch": -1.7}
+    for side in robot.SIDES:
+        for joint in robot.arm_joint_names(side):
+            data.qpos[model.joint(joint).qposadr[0]] = reference.get(joint[2:], 0.0)
+    mujoco.mj_kinematics(model, data)
+    for side in robot.SIDES:
+        wrist = data.site_xpos[model.site(robot.ee_site(side)).id]
+        assert wrist[2] < 0.86 and 0.25 < wrist[0] < 0.4  # the table top is at 1.0 m, its front edge at x 0.25

@@ -110,13 +110,39 @@ def test_key_light_direction_and_strength_per_task():
     assert shelf.nlight == default.nlight == 1
 
 
-def test_shadows_are_opt_in_on_the_key_light_only():
-    plain = build_world(make_robot("gr1t2"), make_task("tabletop"), image_size=(16, 16)).model
-    shadowed = build_world(make_robot("gr1t2"), make_task("tabletop"), image_size=(16, 16), shadows=True).model
+def test_the_key_light_casts_shadows_by_default_and_the_arena_casts_none():
+    robot, task = make_robot("gr1t2"), make_task("tabletop")
+    shadowed = build_world(robot, task, image_size=(16, 16)).model
+    plain = build_world(robot, task, image_size=(16, 16), shadows=False).model
     assert not plain.light_castshadow.any()
-    assert shadowed.light_castshadow[shadowed.light(scene.KEY_LIGHT).id]
+    key = shadowed.light(scene.KEY_LIGHT).id
+    assert shadowed.light_castshadow.nonzero()[0].tolist() == [key]
     assert shadowed.vis.quality.shadowsize == scene.SHADOW_MAP_PX
     assert shadowed.vis.quality.offsamples == 0
+    casts = {shadowed.geom(g).name: bool(shadowed.geom_castshadow[g]) for g in range(shadowed.ngeom)}
+    assert not any(cast for name, cast in casts.items() if name.startswith(("floor", "table")))
+    assert casts["soup_can/mesh"] and casts["gr1t2/left_finger_a/visual39"]
+
+
+@pytest.mark.parametrize("task_name", ["tabletop", "multi_shelf_scan"])
+def test_the_shadow_map_covers_the_workspace_along_the_key_light(task_name):
+    model = _model(task_name)
+    key = model.light(scene.KEY_LIGHT).id
+    np.testing.assert_allclose(model.vis.map.shadowclip * model.stat.extent, scene.SHADOW_HALF_WIDTH_M, rtol=1e-6)
+    # MuJoCo centres a directional light's shadow map on the line through its position along its direction
+    to_centre = np.subtract(scene.SHADOW_CENTRE, model.light_pos[key])
+    np.testing.assert_allclose(to_centre, scene.KEY_LIGHT_DISTANCE_M * model.light_dir[key], atol=1e-6)
+
+
+def test_the_arms_shadow_darkens_the_table_under_the_key_light():
+    env = TavisEnv("tabletop", "gr1t2", camera_mode="fixed_only", image_size=(48, 64))
+    flat = TavisEnv("tabletop", "gr1t2", camera_mode="fixed_only", image_size=(48, 64), shadows=False)
+    shadowed, plain = (e.reset(seed=0)[0]["pixels"]["fixed"].astype(float) for e in (env, flat))
+    env.close()
+    flat.close()
+    darker = plain.mean(axis=2) - shadowed.mean(axis=2)
+    assert (darker > 20).mean() > 0.01  # the shadows of the arms and objects
+    assert (abs(darker) < 8).mean() > 0.5  # the lit rest looks as without shadows
 
 
 def _is(colour: str, patch: np.ndarray) -> bool:

@@ -25,6 +25,7 @@ class ScriptedEnv(gym.Env):
     def __init__(self, actions, success=True, camera_mode="head_only"):
         self.actions, self.success = actions, success
         self.robot_name, self.task, self.split, self.camera_mode = "gr1t2", "clutter_pick_lift", "id", camera_mode
+        self.shadows = True
         self.task_description = "Lift the red soup can off the table."
 
     def reset(self, *, seed=None, options=None):
@@ -59,6 +60,7 @@ def test_a_successful_episode_is_logged_once_with_its_galt(tmp_path):
     (record,) = [json.loads(line) for line in log.read_text().splitlines()]
     assert record["seed"] == 1005 and record["success"] and record["length_steps"] == len(actions)
     assert record["suite"] == "tavis_head" and record["task_id"] == 3 and record["task"] == "clutter_pick_lift"
+    assert record["camera_mode"] == "head_only" and record["shadows"] is True
     assert record["conditions"] == {"target_lifted": True, "target_slow": True,
                                     "target_height_m": 1.0 + 0.01 * len(actions)}  # the final step's
     assert record["reach"] == {"closest_hand_m": 0.3 / len(actions), "target_moved_m": 0.01 * len(actions)}
@@ -93,7 +95,7 @@ def test_the_log_writes_the_fields_of_every_metric_in_registry_order(tmp_path):
     log = tmp_path / "episodes.jsonl"
     info = _run(EpisodeLogger(ScriptedEnv(actions), log, "tavis_head", 0), 0, len(actions))
     (record,) = [json.loads(line) for line in log.read_text().splitlines()]
-    assert list(record) == ["robot", "suite", "task", "task_id", "split", "camera_mode", "seed", "success",
-                            "length_steps", "prompt", "conditions", "reach", *GALT.fields, *WRIST_LEAD.fields,
+    assert list(record) == ["robot", "suite", "task", "task_id", "split", "camera_mode", "shadows", "seed",
+                            "success", "length_steps", "prompt", "conditions", "reach", *GALT.fields, *WRIST_LEAD.fields,
                             "instability"]
     assert all(info[field] == record[field] for field in GALT.fields + WRIST_LEAD.fields)

@@ -33,7 +33,7 @@ KEY_LIGHT_DIR = (0.643, -0.236, -0.728)
 KEY_LIGHT_INTENSITY = 1000.0
 # Light wood, as the shelf appears in the reference's renders (its base colour (0.55, 0.35, 0.20) is lit there far
 # more strongly than MuJoCo's clamped lighting allows). The back panel is a shade darker, so that the boards stand
-# out against it without shadows.
+# out against it also with shadows off.
 SHELF_LOOK = scene.Look("shelf_wood", (0.94, 0.79, 0.58, 1.0), "wood.png", period_m=0.5, specular=0.1, shininess=0.1)
 SHELF_BACK_LOOK = scene.Look("shelf_back", (0.78, 0.64, 0.46, 1.0), "wood.png", period_m=0.5, specular=0.1,
                              shininess=0.1)

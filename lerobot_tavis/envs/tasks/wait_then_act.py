@@ -24,8 +24,9 @@ LIGHT = "signal_light"
 LIGHT_RADIUS_M = 0.03
 RED = (1.0, 0.0, 0.0, 1.0)
 GREEN = (0.0, 1.0, 0.0, 1.0)
-# a glowing lamp; its colour is the geom's rgba (RED or GREEN), which overrides the material's
-LIGHT_LOOK = Look("signal_lamp", specular=0.5, shininess=0.8, emission=0.6)
+# a plain diffuse ball, as the reference's (no glow, no highlight); its colour is the geom's rgba (RED or GREEN),
+# which overrides the material's
+LIGHT_LOOK = Look("signal_lamp", specular=0.0)
 
 
 @dataclass(frozen=True)
