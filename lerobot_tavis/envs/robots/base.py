@@ -27,6 +27,10 @@ class Robot(abc.ABC):
     visual_assets: ClassVar[str | None] = None  # `assets/<group>/visuals.json` to dress it in; None: primitives only
     canonical_origin: ClassVar[tuple[float, float, float]]  # world position of the canonical (hip) frame
     rest_posture_seed: ClassVar[dict[str, tuple[float, ...]]]  # seeds the rest calibration (calibration.py)
+    # True: the rest posture also turns the hand to the canonical rest orientation, so the end-effector frame is the
+    # hand frame (as in the reference); False: the rest posture keeps the seed's wrist and the end-effector frame
+    # takes up the difference (for a wrist that cannot turn that far)
+    rest_turns_hand: ClassVar[bool] = False
     gripper: ClassVar[GripperGeometry]
     # lateral distance (m, world y) of the left shoulder from the body's mid-plane (the right one mirrors it); the
     # demonstrators aim a hand's approach from (0, ±shoulder_y_m) to the object

@@ -48,6 +48,7 @@ class GR1T2(Robot):
         "left": (-0.335, -0.008, 0.046, -1.778, 0.0, 0.0, 0.0),
         "right": (-0.335, 0.008, -0.047, -1.778, 0.0, 0.0, 0.0),
     }
+    rest_turns_hand = True
     gripper = GripperGeometry(stroke_m=0.085, palm_length_m=0.07, palm_half_width_m=0.062,
                               finger_length_m=0.055, pad_length_m=0.035, mount_offset_m=0.023)
     # The shoulder's three axes pass through y = 0.10 (pitch), 0.19 (roll) and 0.23 m (yaw) at the zero pose; 0.2 m is
