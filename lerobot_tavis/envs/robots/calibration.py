@@ -43,11 +43,9 @@ def calibrate(robot_cls) -> RestCalibration:
     origin = np.asarray(robot.canonical_origin)
     tasks = [posture]
     for side in robot.SIDES:
-        task = mink.FrameTask(robot.ee_site(side), "site", position_cost=1.0,
-                              orientation_cost=1.0 if robot.rest_turns_hand else 0.0)
+        task = mink.FrameTask(robot.ee_site(side), "site", position_cost=1.0, orientation_cost=0.0)
         position = np.asarray(canonical.REST_POSITION[side]) + origin
-        rotation = mink.SO3(np.asarray(canonical.REST_QUATERNION[side], dtype=float))
-        task.set_target(mink.SE3.from_rotation_and_translation(rotation, position))
+        task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3.identity(), position))
         tasks.append(task)
     limits = [mink.ConfigurationLimit(model)]
     for _ in range(ITERATIONS):
