@@ -11,9 +11,9 @@ task's, so the layout is the `id` one), within these ranges:
 - `lighting`: the key light turned by -60..60 deg of azimuth around the vertical, elevation 25-75 deg, intensity
   0.5-1.5 x the task's, colour temperature 3000-8000 K; the dome (headlight ambient) 0.3-0.7.
 - `distractors`: 2-4 shapes (box, cylinder, sphere, capsule) of 2-5 cm, in random colours, on the table behind
-  and beside the objects' workspace (on the floor beside the robot for tasks without a table), at least MIN_CLEARANCE_M from every
-  task geom. They touch nothing (contype 0), so they never block a grasp, and stand behind or beside the task's
-  objects as the cameras see them.
+  and beside the objects' workspace (on the floor beside the robot for tasks without a table), at least
+  MIN_CLEARANCE_M from every task geom. They touch nothing (contype 0), so they never block a grasp, and stand
+  behind or beside the task's objects as the cameras see them.
 
 `ood_visual` applies all five; `ood_visual:<factor>` one alone, for ablations (e.g. `ood_visual:lighting`). The
 extra materials, walls and shapes exist only in an `ood_visual` model, so the `id` model, its pixels and every
