@@ -27,10 +27,21 @@ from lerobot_tavis.envs.assets import add_material, add_texture
 from lerobot_tavis.envs.modes import OVERVIEW_CAMERA
 from lerobot_tavis.envs.transforms import camera_quat, vfov_deg
 
+# The reference's packing table as the paper's figure shows it (docs/assets.md): a grey metal top 1.0 m high whose
+# front and back edges lie near x 0.22 and 0.90 and whose sides lie beyond every camera's view (2.6 m wide, centred
+# on y -0.1 like the reference's table pose), a rounded front lip, and storage bins on a shelf under the front edge.
 TABLE_TOP_Z = 1.0
-TABLE_X = (0.25, 0.85)
-TABLE_Y = (-0.55, 0.55)
-TABLE_THICKNESS = 0.04
+TABLE_X = (0.22, 0.90)
+TABLE_Y = (-1.40, 1.20)
+TABLE_THICKNESS = 0.05
+TABLE_LIP_RADIUS_M = 0.025  # the front edge is a half-round bullnose, flush with the top
+TABLE_LEG_HALF_M = 0.03  # square legs, set in from the edges by TABLE_LEG_INSET_M
+TABLE_LEG_INSET_M = 0.06
+BIN_SHELF_Z = 0.60  # the shelf's top face; bins stand on it just behind the front edge
+BIN_SIZE_M = (0.35, 0.42, 0.20)  # depth (x), width (y), height (z)
+BIN_GAP_M = 0.04
+BIN_FRONT_X = 0.25
+TABLE_TOP_GEOMS = ("table/top", "table/lip", "table/surface")  # drawn with TABLE_TOP_LOOK (ood_visual varies it)
 TABLE_SURFACE_GRID_M = 0.05  # tessellation of the drawn table top (m)
 TABLE_SURFACE_LIFT_M = 0.0005  # the drawn top lies this far above the collision box's top face
 FLOOR_GRID_M = 0.5  # tessellation of the drawn floor (m)
@@ -78,6 +89,8 @@ TABLE_TOP_LOOK = Look("table_top", (0.76, 0.77, 0.79, 1.0), "brushed_metal.png",
                       shininess=0.12)
 TABLE_LEG_LOOK = Look("table_leg", (0.30, 0.30, 0.32, 1.0), "brushed_metal.png", period_m=1.0, specular=0.4,
                       shininess=0.3)
+BIN_LOOKS = (Look("bin_blue", (0.13, 0.30, 0.62, 1.0)), Look("bin_yellow", (0.86, 0.70, 0.14, 1.0)),
+             Look("bin_cardboard", (0.62, 0.47, 0.30, 1.0)))
 FLOOR_LOOK = Look("floor", texture="floor_tile.png", period_m=0.5, specular=0.15, shininess=0.1)
 
 
@@ -125,15 +138,26 @@ def add_floor(spec: mujoco.MjSpec) -> None:
 
 
 def add_table(spec: mujoco.MjSpec) -> None:
-    """A static table whose brushed-metal top surface is at TABLE_TOP_Z, on four legs."""
+    """The static packing table: a brushed-metal top whose surface is at TABLE_TOP_Z over TABLE_X x TABLE_Y, with a
+    rounded front lip, on six legs, and a shelf of coloured bins under its front edge.
+
+    The top and the lip collide; legs, shelf and bins are drawn only (nothing reaches under the table) and cast no
+    shadow (they stand in the top's shadow).
+    """
     table = spec.worldbody.add_body(name="table")
-    cx, cy = np.mean(TABLE_X), np.mean(TABLE_Y)
-    hx, hy = (TABLE_X[1] - TABLE_X[0]) / 2, (TABLE_Y[1] - TABLE_Y[0]) / 2
+    lip = TABLE_LIP_RADIUS_M
+    x0, x1 = TABLE_X[0] + lip, TABLE_X[1]  # the flat top; the lip rounds off its front
+    y0, y1 = TABLE_Y
+    cx, cy, hx, hy = (x0 + x1) / 2, (y0 + y1) / 2, (x1 - x0) / 2, (y1 - y0) / 2
     top = table.add_geom(name="table/top", type=mujoco.mjtGeom.mjGEOM_BOX)
     top.size = (hx, hy, TABLE_THICKNESS / 2)
     top.pos = (cx, cy, TABLE_TOP_Z - TABLE_THICKNESS / 2)
     physics.style_geom(top, physics.STATIC)
     use_look(spec, top, TABLE_TOP_LOOK)
+    front = table.add_geom(name="table/lip", type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+                           fromto=(x0, y0 + lip, TABLE_TOP_Z - lip, x0, y1 - lip, TABLE_TOP_Z - lip), size=(lip, 0, 0))
+    physics.style_geom(front, physics.STATIC)
+    use_look(spec, front, TABLE_TOP_LOOK)
     # The top face drawn again as a finely tessellated plane just above it: MuJoCo lights per vertex, and a box
     # face's few vertices would turn the key light's soft highlight into blotches.
     surface = table.add_geom(name="table/surface", type=mujoco.mjtGeom.mjGEOM_PLANE)
@@ -142,13 +166,27 @@ def add_table(spec: mujoco.MjSpec) -> None:
     physics.style_geom(surface, physics.VISUAL)
     surface.castshadow = False  # the box below casts the table's shadow
     use_look(spec, surface, TABLE_TOP_LOOK)
+
+    def drawn_box(name: str, centre, half_size, look: Look) -> None:
+        geom = table.add_geom(name=f"table/{name}", type=mujoco.mjtGeom.mjGEOM_BOX, pos=centre, size=half_size)
+        physics.style_geom(geom, physics.VISUAL)
+        geom.castshadow = False
+        use_look(spec, geom, look)
+
     leg_half_h = (TABLE_TOP_Z - TABLE_THICKNESS) / 2
-    for i, (sx, sy) in enumerate(((1, 1), (1, -1), (-1, 1), (-1, -1))):
-        leg = table.add_geom(name=f"table/leg{i}", type=mujoco.mjtGeom.mjGEOM_BOX)
-        leg.size = (0.025, 0.025, leg_half_h)
-        leg.pos = (cx + sx * (hx - 0.05), cy + sy * (hy - 0.05), leg_half_h)
-        physics.style_geom(leg, physics.VISUAL)
-        use_look(spec, leg, TABLE_LEG_LOOK)
+    leg_x = (TABLE_X[0] + TABLE_LEG_INSET_M, TABLE_X[1] - TABLE_LEG_INSET_M)
+    leg_y = (y0 + TABLE_LEG_INSET_M, y1 - TABLE_LEG_INSET_M)
+    legs = [(x, y) for x in leg_x for y in leg_y] + [(leg_x[1], cy)]  # no middle front leg: the robot stands there
+    for i, (x, y) in enumerate(legs):
+        drawn_box(f"leg{i}", (x, y, leg_half_h), (TABLE_LEG_HALF_M, TABLE_LEG_HALF_M, leg_half_h), TABLE_LEG_LOOK)
+    shelf_half_z = 0.01
+    drawn_box("shelf", (cx, cy, BIN_SHELF_Z - shelf_half_z), (hx, hy, shelf_half_z), TABLE_LEG_LOOK)
+    depth, width, height = BIN_SIZE_M
+    count = int((y1 - y0 - 2 * TABLE_LEG_INSET_M) // (width + BIN_GAP_M))
+    for i in range(count):
+        y = cy + (i - (count - 1) / 2) * (width + BIN_GAP_M)
+        drawn_box(f"bin{i}", (BIN_FRONT_X + depth / 2, y, BIN_SHELF_Z + height / 2), (depth / 2, width / 2, height / 2),
+                  BIN_LOOKS[i % len(BIN_LOOKS)])
 
 
 def add_lights(spec: mujoco.MjSpec, *, shadows: bool) -> None:

@@ -10,10 +10,10 @@ task's, so the layout is the `id` one), within these ranges:
   0.4-1.0).
 - `lighting`: the key light turned by -60..60 deg of azimuth around the vertical, elevation 25-75 deg, intensity
   0.5-1.5 x the task's, colour temperature 3000-8000 K; the dome (headlight ambient) 0.3-0.7.
-- `distractors`: 2-4 shapes (box, cylinder, sphere, capsule) of 2-5 cm, in random colours, on the table's back
-  and side rims (on the floor beside the robot for tasks without a table), at least MIN_CLEARANCE_M from every
-  task geom. They touch nothing (contype 0), so they never block a grasp, and stand behind or beside the task's
-  objects as the cameras see them.
+- `distractors`: 2-4 shapes (box, cylinder, sphere, capsule) of 2-5 cm, in random colours, on the table behind
+  and beside the objects' workspace (on the floor beside the robot for tasks without a table), at least
+  MIN_CLEARANCE_M from every task geom. They touch nothing (contype 0), so they never block a grasp, and stand
+  behind or beside the task's objects as the cameras see them.
 
 `ood_visual` applies all five; `ood_visual:<factor>` one alone, for ablations (e.g. `ood_visual:lighting`). The
 extra materials, walls and shapes exist only in an `ood_visual` model, so the `id` model, its pixels and every
@@ -42,8 +42,8 @@ LIGHT_INTENSITY_SCALE, LIGHT_KELVIN, DOME_AMBIENT = (0.5, 1.5), (3000.0, 8000.0)
 DISTRACTOR_COUNT, DISTRACTOR_SIZE_M = (2, 4), (0.02, 0.05)
 DISTRACTOR_SHAPES = ("box", "cylinder", "sphere", "capsule")
 MIN_CLEARANCE_M = 0.05
-TABLE_RIMS = (((0.74, 0.82), (-0.50, 0.50)),  # back rim: (x range, y range), world frame
-              ((0.35, 0.80), (0.45, 0.51)), ((0.35, 0.80), (-0.51, -0.45)))  # side rims
+TABLE_BANDS = (((0.74, 0.82), (-0.50, 0.50)),  # behind the workspace: (x range, y range), world frame
+               ((0.35, 0.80), (0.45, 0.51)), ((0.35, 0.80), (-0.51, -0.45)))  # beside it
 FLOOR_BANDS = (((0.3, 1.0), (0.7, 1.0)), ((0.3, 1.0), (-1.0, -0.7)))
 MAX_PLACEMENT_TRIES = 50
 PREFIX = f"{VISUAL_SPLIT}/"
@@ -61,7 +61,7 @@ def add_variation_pieces(spec: mujoco.MjSpec, *, has_table: bool) -> None:
                      shininess=look.shininess, texrepeat=(repeat, repeat), texuniform=True)
     add_material(spec, BACKDROP_MATERIAL, specular=0.0, shininess=0.0)
     if has_table:
-        for name in ("table/top", "table/surface"):
+        for name in scene.TABLE_TOP_GEOMS:
             spec.geom(name).material = TABLE_MATERIAL
     spec.geom("floor/tiles").material = FLOOR_MATERIAL
     d, thin = BACKDROP_DISTANCE_M, 0.01
@@ -208,7 +208,7 @@ def kelvin_rgb(kelvin: float) -> np.ndarray:
 def _place_distractors(model, data, rng, has_table: bool, robot_prefix: str) -> tuple:
     others = task_geoms(model, robot_prefix)
     count = int(rng.integers(DISTRACTOR_COUNT[0], DISTRACTOR_COUNT[1] + 1))
-    bands = TABLE_RIMS if has_table else FLOOR_BANDS
+    bands = TABLE_BANDS if has_table else FLOOR_BANDS
     base_z = scene.TABLE_TOP_Z if has_table else 0.0
     placed = []
     for index in range(count):
@@ -225,7 +225,7 @@ def _place_distractors(model, data, rng, has_table: bool, robot_prefix: str) -> 
                 model.geom_group[geom] = physics.GROUP_VISIBLE
                 placed.append((geom, DISTRACTOR_SHAPES[index % len(DISTRACTOR_SHAPES)], size))
                 break
-        else:  # no free spot on this episode's rims: leave it out
+        else:  # no free spot in this episode's bands: leave it out
             model.geom_pos[geom] = (0.0, 0.0, -1.0)
     mujoco.mj_kinematics(model, data)
     return tuple((shape, tuple(float(v) for v in data.geom_xpos[geom]), size) for geom, shape, size in placed)

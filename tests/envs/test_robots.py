@@ -112,3 +112,26 @@ def test_the_references_default_joints_would_put_reachy2s_wrists_under_the_table
     for side in robot.SIDES:
         wrist = data.site_xpos[model.site(robot.ee_site(side)).id]
         assert wrist[2] < 0.86 and 0.25 < wrist[0] < 0.4  # the table top is at 1.0 m, its front edge at x 0.25
+
+
+def test_gr1t2_wrist_cameras_point_for_a_command_as_the_reference_s():
+    """The reference's IK drives the hand link itself to the commanded quaternion, and its wrist camera sits on that
+    link at (0.15, 0, 0.05) with the optical axis along +x turned 125° about y; ours rides on the end-effector frame
+    the same way, so at rest it looks 24.6° below the horizon from where the reference's does."""
+    robot, model, data = _compiled("gr1t2")
+    calibration = robot.calibration()
+    for side in robot.SIDES:
+        for joint, value in zip(robot.arm_joint_names(side), calibration.arm_qpos[side]):
+            data.qpos[model.joint(joint).qposadr[0]] = value
+    mujoco.mj_forward(model, data)
+    mount_axis = np.array([math.cos(math.radians(125.0)), 0.0, -math.sin(math.radians(125.0))])
+    for arm in canonical.ARMS:
+        rotation = np.empty(9)
+        mujoco.mju_quat2Mat(rotation, np.asarray(canonical.REST_QUATERNION[arm.side], dtype=float))
+        rotation = rotation.reshape(3, 3)
+        wrist = data.site_xpos[model.site(robot.ee_site(arm.side)).id]
+        camera = model.camera(f"{arm.side}_wrist").id
+        forward = -data.cam_xmat[camera].reshape(3, 3)[:, 2]
+        np.testing.assert_allclose(forward, rotation @ mount_axis, atol=1e-3)
+        np.testing.assert_allclose(data.cam_xpos[camera], wrist + rotation @ (0.15, 0.0, 0.05), atol=1e-3)
+        assert math.degrees(-math.asin(forward[2])) == pytest.approx(24.6, abs=0.1)

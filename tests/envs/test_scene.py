@@ -204,3 +204,23 @@ def test_a_head_pitched_fully_down_does_not_blind_the_fixed_camera():
     dark = (obs["pixels"]["fixed"].max(axis=2) < 30).mean()
     env.close()
     assert dark < 0.1  # the head (within 0.1 m of the lens) is clipped; the table and arms stay in view
+
+
+def test_the_table_fills_the_fixed_camera_s_view_from_side_to_side():
+    """As in the reference's figure: below the table's far edge the fixed camera sees table top, not floor, at both
+    sides of its image; the top is flush with its rounded front lip at TABLE_TOP_Z."""
+    env = TavisEnv("clutter_pick_cube", "gr1t2", image_size=(48, 64), cameras=())
+    env.reset(seed=0)
+    model, data = env.model, env.data
+    with mujoco.Renderer(model, 48, 64) as renderer:
+        renderer.enable_segmentation_rendering()
+        renderer.update_scene(data, camera=env.world.cameras[scene.FIXED_CAMERA])
+        segmentation = renderer.render()
+    env.close()
+    geoms = np.where(segmentation[..., 1] == mujoco.mjtObj.mjOBJ_GEOM, segmentation[..., 0], -1)
+    table = [g for g in range(model.ngeom) if model.geom(g).name.startswith("table/")]
+    for row in (26, 32, 38):  # between the far edge (row ~19) and the front lip (row ~41)
+        assert np.isin(geoms[row, [0, -1]], table).all(), row
+    lip, top = model.geom("table/lip").id, model.geom("table/top").id
+    assert model.geom_pos[lip][2] + model.geom_size[lip][0] == pytest.approx(scene.TABLE_TOP_Z)
+    assert model.geom_pos[top][2] + model.geom_size[top][2] == pytest.approx(scene.TABLE_TOP_Z)

@@ -87,7 +87,7 @@ def test_every_factor_stays_in_its_range_and_distractors_stay_clear_over_200_see
                 geom = world.model.geom(f"ood_visual/distractor{index}").id
                 assert visual_ood.DISTRACTOR_SIZE_M[0] <= size <= visual_ood.DISTRACTOR_SIZE_M[1]
                 assert visual_ood.clearance_m(world.model, world.data, geom, others) >= visual_ood.MIN_CLEARANCE_M
-                bands = visual_ood.TABLE_RIMS if world is env else visual_ood.FLOOR_BANDS
+                bands = visual_ood.TABLE_BANDS if world is env else visual_ood.FLOOR_BANDS
                 assert any(x[0] <= position[0] <= x[1] and y[0] <= position[1] <= y[1] for x, y in bands)
         assert len(env.visual_draw.distractors) >= visual_ood.DISTRACTOR_COUNT[0]
     env.close()

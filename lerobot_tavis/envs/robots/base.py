@@ -48,7 +48,8 @@ class Robot(abc.ABC):
     @abc.abstractmethod
     def _build(self, spec: mujoco.MjSpec) -> None:
         """Add the robot's bodies, joints, actuators, sites (`<side>_ee` at the wrist centre with the hand frame's
-        orientation, `<side>_grasp`) and cameras to `spec`."""
+        orientation, `<side>_grasp`) and cameras to `spec`. What hangs in an optional frame `<side>_ee_mount` of
+        the hand (identity here) turns with the end-effector frame once calibrated (`build_spec`)."""
 
     def raw_spec(self) -> mujoco.MjSpec:
         """The robot with its end-effector sites still aligned with the hand frames (input of the calibration)."""
@@ -67,6 +68,9 @@ class Robot(abc.ABC):
         spec = self.raw_spec()
         for side, quat in self.calibration().ee_quat_in_hand.items():
             spec.site(self.ee_site(side)).quat = quat
+            mount = spec.frame(self.ee_mount(side))
+            if mount is not None:
+                mount.quat = quat
         if dressed and self.visual_assets:
             visuals.dress(spec, self.visual_assets)
         return spec
@@ -101,6 +105,10 @@ class Robot(abc.ABC):
 
     def ee_site(self, side: str) -> str:
         return f"{side}_ee"
+
+    def ee_mount(self, side: str) -> str:
+        """Name of the hand's frame that `build_spec` turns into the end-effector frame (at the wrist centre)."""
+        return f"{side}_ee_mount"
 
     def grasp_site(self, side: str) -> str:
         return f"{side}_grasp"

@@ -55,7 +55,9 @@ class GR1T2(Robot):
     shoulder_y_m = 0.2
     head_camera = CameraMount(pos=(0.10, 0.0, 0.0), look_at=(1.10, 0.0, 0.0), up=(0.0, 0.0, 1.0),
                               hfov_deg=HEAD_HFOV_DEG)
-    # Reference mount: 15 cm above and 5 cm behind the wrist centre, looking 35° down past the fingertips.
+    # Reference mount: 15 cm above and 5 cm behind the wrist centre, looking 35° down past the fingertips. The
+    # reference mounts it on the link its IK drives to the commanded quaternion, which here is the end-effector
+    # frame (`<side>_ee_mount`, see Robot.build_spec): a command points the camera as it points the reference's.
     wrist_camera = parts.wrist_camera_mount(height_m=0.15, back_m=0.05, look_depth_m=0.164, hfov_deg=WRIST_HFOV_DEG)
 
     def arm_joints(self, side: str) -> tuple[JointDef, ...]:
@@ -123,7 +125,8 @@ class GR1T2(Robot):
         physics.style_geom(wrist, physics.ROBOT, JOINT_RGBA)
         hand.add_site(name=self.ee_site(side), size=(0.008, 0.0, 0.0), group=4)
         parts.add_gripper(spec, hand, side, self.gripper, JOINT_RGBA)
+        mount = hand.add_frame(name=self.ee_mount(side))
         cam = np.asarray(self.wrist_camera.pos)
-        parts.add_limb(hand, f"{side}_camera_post", (0.03, 0.0, -0.03), cam - (0.012, 0.0, 0.0), 0.008,
+        parts.add_limb(mount, f"{side}_camera_post", (0.03, 0.0, -0.03), cam - (0.012, 0.0, 0.0), 0.008,
                        JOINT_RGBA, role=physics.VISUAL)
-        parts.add_camera(hand, f"{side}_wrist", self.wrist_camera)
+        parts.add_camera(mount, f"{side}_wrist", self.wrist_camera)

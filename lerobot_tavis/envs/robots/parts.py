@@ -68,7 +68,8 @@ def add_servo(spec: mujoco.MjSpec, joint: str, range_rad, servo: Servo) -> None:
     actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
 
 
-def add_limb(body: mujoco.MjsBody, name: str, start, end, radius: float, rgba, role=physics.ROBOT) -> None:
+def add_limb(body: mujoco.MjsBody | mujoco.MjsFrame, name: str, start, end, radius: float, rgba,
+             role=physics.ROBOT) -> None:
     """A capsule from `start` to `end` (body frame, m)."""
     geom = body.add_geom(name=name, type=CAPSULE, fromto=(*start, *end), size=(radius, 0.0, 0.0))
     physics.style_geom(geom, role, rgba)
@@ -166,7 +167,8 @@ class CameraMount:
         return camera_quat(np.subtract(self.look_at, self.pos), self.up)
 
 
-def add_camera(body: mujoco.MjsBody, name: str, mount: CameraMount, *, housing: bool = True) -> None:
+def add_camera(body: mujoco.MjsBody | mujoco.MjsFrame, name: str, mount: CameraMount, *,
+               housing: bool = True) -> None:
     body.add_camera(name=name, pos=mount.pos, quat=mount.quat, fovy=vfov_deg(mount.hfov_deg))
     if housing:
         direction = np.subtract(mount.look_at, mount.pos)
