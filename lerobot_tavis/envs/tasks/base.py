@@ -55,7 +55,7 @@ class TargetFacts(EpisodeFacts):
 
 class Task(abc.ABC):
     info: ClassVar[TaskInfo]
-    VARIANTS: ClassVar[dict[str, Any]]  # "id" and "ood_spatial" presets (reference §2)
+    VARIANTS: ClassVar[dict[str, Any]]  # "id" and "ood_spatial" presets (docs/reference.md §4)
     has_table: ClassVar[bool] = True
     blacked_out_cameras: ClassVar[frozenset[str]] = frozenset()
 

@@ -1,7 +1,7 @@
 """TAVIS-Head multi_shelf_scan: five objects in six slots of a three-shelf unit; take the named one out.
 
 No table. Success: the target's origin is nearer than x = 0.435 m (out of the shelf) and slower than 1 m/s; no
-height condition (reference §2.5).
+height condition (docs/reference.md §4).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ SLOT_Y_CLAMP = (-0.32, 0.32)
 INNER_X = (SHELF_X - SHELF_DEPTH / 2, SHELF_X + SHELF_DEPTH / 2 - 0.005)  # open front .. back panel
 INNER_Y = (-SHELF_WIDTH / 2, SHELF_WIDTH / 2)
 SUCCESS_X = SHELF_X - SHELF_DEPTH / 2 - 0.03  # 0.435 m
-# This task's own key light (reference §2.5): from behind-left of the robot into the shelf's open front.
+# This task's own key light (docs/reference.md §4): from behind-left of the robot into the shelf's open front.
 KEY_LIGHT_DIR = (0.643, -0.236, -0.728)
 KEY_LIGHT_INTENSITY = 1000.0
 # Light wood, as the shelf appears in the reference's renders (its base colour (0.55, 0.35, 0.20) is lit there far
