@@ -2,7 +2,7 @@
 
     python benchmarks/layout_density.py [--layouts 2000] [--plot docs/images/layout_density.png]
 
-The reference sampler is simulated as described in reference/tavis_benchmark.md §2.1 (centres uniform in the
+The reference sampler is simulated as described in docs/reference.md §4 (centres uniform in the
 zone, each object takes its first draw farther than the minimum separation from every placed centre, else its
 5000th draw), with a uniform yaw per object so that interpenetrating pairs can be counted with the objects' real
 outlines. Ours is `lerobot_tavis.envs.tasks.layout.sample_layout`. Prints a Markdown table and saves histograms.

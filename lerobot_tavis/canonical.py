@@ -1,6 +1,6 @@
 """The canonical 19-D action (and state) shared by both robots.
 
-Layout (reference §4), every position in the canonical frame: the robot root's orientation with its origin at
+Layout (docs/reference.md §6), every position in the canonical frame: the robot root's orientation with its origin at
 hip level (world z 0.93), x forward, y left, z up; quaternions w, x, y, z.
 
     [0:3]   left end-effector position, m        [3:7]   left end-effector orientation
@@ -49,7 +49,7 @@ ACTION_NAMES: tuple[str, ...] = (
     "right_gripper",
 )
 
-# Rest end-effector poses (reference §3.1), canonical frame.
+# Rest end-effector poses (docs/reference.md §5), canonical frame.
 REST_POSITION = {"left": (0.3, 0.2, 0.3), "right": (0.3, -0.2, 0.3)}
 REST_QUATERNION = {
     "left": (0.6400948, -0.00045091, -0.7682481, -0.00857063),

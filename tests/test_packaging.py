@@ -1,3 +1,4 @@
+import re
 import shutil
 import subprocess
 import sys
@@ -48,3 +49,35 @@ def test_setup_with_cpu_installs_torch_from_the_cpu_index_before_the_package(tmp
     assert calls[-1].startswith("-m pip install --index-url https://download.pytorch.org/whl/cpu torch>=2.7,<2.12 ")
     assert "CPU=1: PyTorch's CPU wheels could not be installed" in result.stdout + result.stderr
     assert not (tmp_path / "cpu" / "venv" / ".installed").exists()
+
+
+TEXT_SUFFIXES = {".py", ".md", ".sh", ".toml", ".txt", ".cfg", ".yaml", ".yml"}
+# Files that exist only outside the repository; the facts the project needs from them are in docs/reference.md.
+NOT_SHIPPED = ("reference" + " §", "robots_objects" + "_physics", "tavis_benchmark" + ".md", "DESIGN" + ".md")
+
+
+def _project_texts():
+    for top in ("lerobot_tavis", "lerobot_env_tavis", "tests", "benchmarks", "tools", "docs"):
+        for path in sorted((ROOT / top).rglob("*")):
+            if path.suffix in TEXT_SUFFIXES and "__pycache__" not in path.parts:
+                yield path
+    for name in ("README.md", "Makefile", "pyproject.toml"):
+        yield ROOT / name
+
+
+def test_citations_name_only_files_that_ship():
+    """Every "§" cites a numbered section of docs/reference.md that exists; no file cites notes that do not ship."""
+    reference = (ROOT / "docs" / "reference.md").read_text()
+    sections = set(re.findall(r"^## §(\d+) ", reference, flags=re.MULTILINE))
+    assert sections == {str(n) for n in range(1, len(sections) + 1)}
+    bad = []
+    for path in _project_texts():
+        text = path.read_text(errors="replace")
+        bad += [f"{path.relative_to(ROOT)}: {name}" for name in NOT_SHIPPED if name in text]
+        if path.name == "reference.md" and path.parent.name == "docs":
+            continue
+        for match in re.finditer(r"§(\d+)", text):
+            cited_here = "reference.md" in text[max(0, match.start() - 40):match.start()]
+            if not cited_here or match.group(1) not in sections:
+                bad.append(f"{path.relative_to(ROOT)}: {text[max(0, match.start() - 40):match.end()]!r}")
+    assert bad == []

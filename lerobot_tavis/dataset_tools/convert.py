@@ -3,9 +3,9 @@
 Each raw episode is replayed from its seed with its recorded 60 Hz actions. Every (60 / fps)-th step becomes a
 frame: the observation at that step (images, measured canonical state, joint positions) with the last 60 Hz action
 of the frame's interval, the command in force when the next frame is observed. This is the pairing the reference
-trains on (its +1 action shift, reference §9): a 20 Hz policy holds each action for three ticks, and holding the
-interval's first command instead leaves the hands lagging the recording, a few millimetres under the lift line at
-the end of a demonstration (`tavis verify-dataset` measures it).
+trains on (its +1 action shift, docs/reference.md §11): a 20 Hz policy holds each action for three ticks, and
+holding the interval's first command instead leaves the hands lagging the recording, a few millimetres under the
+lift line at the end of a demonstration (`tavis verify-dataset` measures it).
 
 The replay must end as the recording did (success and length), else the conversion stops with an error; the
 largest joint-state deviation from the recorded states is kept per episode in `meta/tavis_conversion.json`.

@@ -1,6 +1,6 @@
 """Import a dataset published by the original TAVIS benchmark (e.g. `tavis-benchmark/tavis-head-gr1t2`) into our schema.
 
-The source is a local LeRobotDataset v3.0 recorded by teleoperation at 60 Hz (reference §10): cameras
+The source is a local LeRobotDataset v3.0 recorded by teleoperation at 60 Hz (docs/reference.md §11): cameras
 `observation.images.OBS_{HEAD,FIXED,WRIST_LEFT,WRIST_RIGHT}` (videos), `observation.state` = the robot's full
 joint vector, `observation.{left,right}_eef_{pos,quat}`, the 19-D canonical `action`, `language_instruction`, and
 the task *class* name (e.g. "ConditionalPickTask") as LeRobot's `task`. The result follows
@@ -10,10 +10,11 @@ the task *class* name (e.g. "ConditionalPickTask") as LeRobot's `task`. The resu
 Frame alignment. The source pairs, in its frame k, the action sent at step k with the observation measured *after*
 step k. With `stride = 60 / fps`, our frame j holds the observation of source frame s = stride * j and the action
 of source frame s + stride: the last of the `stride` commands sent after that observation, as the reference's
-training reads it (its +1 action shift, §9) and as `tavis convert` pairs its own recordings. A source episode of n
-frames gives floor((n - 1) / stride) frames: the last observations have no complete interval after them.
+training reads it (its +1 action shift, docs/reference.md §11) and as `tavis convert` pairs its own recordings.
+A source episode of n frames gives floor((n - 1) / stride) frames: the last observations have no complete interval
+after them.
 
-Canonical state of source frame s (reference §4, §5):
+Canonical state of source frame s (docs/reference.md §6, §11):
 
 - hand positions: `observation.{left,right}_eef_pos`, already canonical (body minus root minus the canonical offset);
 - hand orientations: `observation.{left,right}_eef_quat` (w, x, y, z; world frame, which is the canonical frame's
@@ -55,7 +56,7 @@ SOURCE_POSE = {
 }
 SOURCE_ACTION = "action"
 SOURCE_PROMPT = "language_instruction"
-# Neck joints (roll, pitch, yaw) by name and, for unnamed joint vectors, by index (reference §3.1).
+# Neck joints (roll, pitch, yaw) by name and, for unnamed joint vectors, by index (docs/reference.md §5).
 NECK = {
     "gr1t2": (("head_roll_joint", "head_pitch_joint", "head_yaw_joint"), (11, 16, 21)),
     "reachy2": (("neck_roll", "neck_pitch", "neck_yaw"), (5, 8, 9)),

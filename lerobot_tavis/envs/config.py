@@ -30,10 +30,13 @@ from lerobot_tavis.envs.checkpoint_settings import SETTINGS, match_settings, rea
 from lerobot_tavis.envs.factory import EPISODE_LOG_NAME, make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_info
-from lerobot_tavis.envs.tasks.catalog import expand_tasks, parse_split, suite_tasks
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SUITES, expand_tasks, parse_split, suite_tasks
 from lerobot_tavis.envs.vector import Frozen, LazyAsyncVectorEnv
 from lerobot_tavis.errors import FieldError
 from lerobot_tavis.process import MAX_NICENESS
+
+# The help of `--env.task`, written from the task registry (draccus reads other fields' help from their comments).
+TASK_HELP = f"Suite ({', '.join(SUITES)}), task ({', '.join(BENCHMARK_TASKS)}) or a comma list of them"
 
 
 @EnvConfig.register_subclass("tavis")
@@ -41,9 +44,7 @@ from lerobot_tavis.process import MAX_NICENESS
 class TavisEnvConfig(EnvConfig):
     """The TAVIS benchmark in MuJoCo (lerobot_tavis): egocentric active vision tasks on a humanoid torso."""
 
-    # Suite (tavis_head, tavis_hands), task (conditional_pick, wait_then_act, clutter_pick_cube, clutter_pick_lift,
-    # multi_shelf_scan, peeking_box, occluded_reach, blocked_clutter_pick_cube) or a comma list of them
-    task: str = "tavis_head"
+    task: str = field(default="tavis_head", metadata={"custom_args": {"help": TASK_HELP}})
     # Policy steps per second; fixed by the benchmark at 20
     fps: int = 20
     # Robot: gr1t2 or reachy2

@@ -261,9 +261,9 @@ class TavisEnv(gym.Env):
                 break
 
     def _warm_up(self, sim: _Sim) -> None:
-        """ood_init_pose (reference §6): hold the rest action perturbed by Gaussian noise (0.10 m per hand axis,
-        0.175 rad on head pitch and yaw, drawn from the episode's generator) for 10 policy steps (0.5 s) before the
-        first observation. As in the reference, they count toward the episode (a 20 s episode leaves 390 policy
+        """ood_init_pose (docs/reference.md §7): hold the rest action perturbed by Gaussian noise (0.10 m per hand
+        axis, 0.175 rad on head pitch and yaw, drawn from the episode's generator) for 10 policy steps (0.5 s) before
+        the first observation. As in the reference, they count toward the episode (a 20 s episode leaves 390 policy
         steps) and toward the task's clock (wait_then_act's light)."""
         action = warm_up_action(self.np_random)
         sim.controller.set_command(action)

@@ -3,7 +3,7 @@
 LeRobot's async vector envs and `tavis eval --expert` call `make_tavis_env` in worker processes, which import this
 module by name: it must import neither LeRobot nor torch (the env config that refers to it does). The episode log
 (`lerobot_tavis.eval.episode_log`) is imported only inside `make_tavis_env`, when one is asked for: this module
-is the one place where the env side attaches it (DESIGN.md, "Data flows one way").
+is the one place where the env side attaches it (docs/extending.md, "Layers").
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@
 `register_camera_mode` (docs/extending.md).
 
 The paper's two conditions are `head_wrist` (its "headcam": head camera and both wrist cameras) and `fixed_wrist`
-(its "fixedcam": fixed workspace camera and both wrists), reference §9; `head_wrist` is the default everywhere.
+(its "fixedcam": fixed workspace camera and both wrists), docs/reference.md §1; `head_wrist` is the default everywhere.
 `head_only` and `fixed_only` (one camera, no wrists) are ablations the paper does not report.
 """
 

@@ -1,7 +1,7 @@
 """The suite's five YCB objects and the red cube: sizes, masses, and how each is added to a model.
 
 Sizes are the published YCB dimensions times the benchmark's 0.75 scale, masses the YCB masses times 0.75³
-(reference/robots_objects_physics.md §2). Every object stands upright (a box's third size is its height) on one
+(docs/reference.md §13). Every object stands upright (a box's third size is its height) on one
 collision primitive whose centre is the body's origin. Dressed, a YCB object is drawn as its scanned, textured mesh
 (`lerobot_tavis/assets/ycb/`, fitted onto the primitive's extents by `tools/assets/ycb.py`) and the primitive is
 hidden; undressed, the primitive itself is drawn in the object's colour. Physics is the same either way. The red

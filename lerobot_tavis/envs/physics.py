@@ -1,6 +1,6 @@
 """Physics and rendering defaults shared by every model piece: one place for timing, contacts and colours.
 
-Grasp-stable settings follow reference/robots_objects_physics.md §4: implicitfast integrator, elliptic friction
+Grasp-stable settings follow docs/reference.md §14: implicitfast integrator, elliptic friction
 cones with impratio 10, solref 0.01 (>= 2 timesteps), condim 4 on gripper pads.
 """
 

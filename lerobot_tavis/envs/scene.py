@@ -3,10 +3,10 @@ materials ("looks") that the arena and the tasks' props are drawn with.
 
 World frame: x forward from the robot, y to its left, z up, floor at z = 0, table top at z = 1.0.
 
-Lighting follows the reference (§1.4): a white dome (here the headlight's ambient and a soft camera fill) plus one
-distant key light from the front-left, above, which casts the scene's shadows (on by default, as in the reference).
-MuJoCo's fixed-function lights have no physical units, so the reference's intensities only set ratios:
-`set_key_light` scales the key light by intensity / 2000.
+Lighting follows the reference (docs/reference.md §2): a white dome (here the headlight's ambient and a soft camera
+fill) plus one distant key light from the front-left, above, which casts the scene's shadows (on by default, as in
+the reference). MuJoCo's fixed-function lights have no physical units, so the reference's intensities only set
+ratios: `set_key_light` scales the key light by intensity / 2000.
 
 Shadows cost a depth pass from the light and a second lit pass per rendered image, so they are kept cheap: one
 shadow-casting light, a SHADOW_MAP_PX map spent on a square SHADOW_HALF_WIDTH_M around SHADOW_CENTRE (the light is
@@ -46,12 +46,12 @@ TABLE_SURFACE_GRID_M = 0.05  # tessellation of the drawn table top (m)
 TABLE_SURFACE_LIFT_M = 0.0005  # the drawn top lies this far above the collision box's top face
 FLOOR_GRID_M = 0.5  # tessellation of the drawn floor (m)
 
-# Workspace camera (reference §1.5): above and in front of the robot, optical axis forward and 45° down.
+# Workspace camera (docs/reference.md §3): above and in front of the robot, optical axis forward and 45° down.
 FIXED_CAMERA = "fixed"
 FIXED_CAMERA_POS = (0.2, 0.0, 1.43)
 FIXED_CAMERA_HFOV_DEG = 120.0
 
-# Key light (reference §1.4): travelling toward the robot and down, intensity 2000 beside a dome of 800.
+# Key light (docs/reference.md §2): travelling toward the robot and down, intensity 2000 beside a dome of 800.
 KEY_LIGHT = "key_light"
 KEY_LIGHT_DIR = (-0.342, -0.321, -0.883)
 KEY_LIGHT_INTENSITY = 2000.0

@@ -12,7 +12,7 @@ from lerobot_tavis.experts.grasping import PITCHES_RAD
 from lerobot_tavis.experts.head_tasks import LIFT, ClutterExpert
 from lerobot_tavis.experts.skills import SkilledExpert
 
-HIGH_LIFT = (0.0, 0.0, 0.29)  # success needs the origin above 1.25 m
+HIGH_LIFT = (0.0, 0.0, 0.29)  # success needs the origin above `HIGH_LIFT_HEIGHT_M` = 1.25 m
 SIDE_OF = {"+y": "left", "-y": "right"}
 # where a hand may peek into the box from (box frame, m): back toward the robot from the nominal spot, out from
 # the open side, height of the wrist; the first reachable one is used

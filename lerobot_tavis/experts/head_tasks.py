@@ -10,8 +10,8 @@ from lerobot_tavis.envs.scene import TABLE_TOP_Z
 from lerobot_tavis.experts.base import Hold, Segment, WaitUntil
 from lerobot_tavis.experts.skills import SkilledExpert
 
-LIFT = (0.0, 0.0, 0.24)  # object origins start near 1.01-1.05 m; success needs > 1.2 m
-PULL_OUT = (-0.18, 0.0, 0.02)  # out of the shelf: success needs x < 0.435 m
+LIFT = (0.0, 0.0, 0.24)  # object origins start near 1.01-1.05 m; success needs > `LIFT_HEIGHT_M` = 1.2 m
+PULL_OUT = (-0.18, 0.0, 0.02)  # out of the shelf: success needs x < `SHELF_EXIT_X_M` = 0.435 m
 
 
 class ConditionalPickExpert(SkilledExpert):

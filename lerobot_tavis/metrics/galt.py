@@ -1,6 +1,6 @@
 """GALT, the Gaze-Action Lead Time: how long the head settles on its final fixation before the hand grasps.
 
-Computed from the commanded action trajectory alone, exactly as the reference detector (reference §8), quirks
+Computed from the commanded action trajectory alone, exactly as the reference detector (docs/reference.md §9), quirks
 included, so numbers compare with published ones:
 
 1. Fewer than 10 steps: `too_short`.

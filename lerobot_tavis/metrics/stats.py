@@ -8,7 +8,7 @@ Z_95 = 1.96
 
 
 def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, float]:
-    """Wilson score interval of a success rate (reference §7.5), clipped to [0, 1]; (0, 0) when n = 0. The bounds
+    """Wilson score interval of a success rate (docs/reference.md §8), clipped to [0, 1]; (0, 0) when n = 0. The bounds
     always contain the rate: at 0 or n successes the formula's bound equals it exactly, and rounding may otherwise
     put it a hair on the wrong side (6/6 gave an upper bound of 0.9999999999999999)."""
     if not 0 <= successes <= n:

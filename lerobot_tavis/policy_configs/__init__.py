@@ -1,7 +1,7 @@
 """Training presets for `lerobot-train --config_path=<preset>`: pi0 and Diffusion Policy x camera modes.
 
 Each preset is a partial LeRobot `TrainPipelineConfig` (JSON, shipped with the package) following the reference's
-hyper-parameters (reference §9) in LeRobot 0.6 fields: an action chunk of 16 of which 8 are executed at 20 Hz,
+hyper-parameters (docs/reference.md §10) in LeRobot 0.6 fields: an action chunk of 16 of which 8 are executed at 20 Hz,
 batch 16; diffusion with 2 observation steps, lr 1e-4 and images resized to 240x320; pi0 fine-tuned from
 `lerobot/pi0_base` with lr 2.5e-5. The policy sees only its camera mode's images plus the canonical state
 (`input_features`), and `env.type=tavis` with the same camera mode makes lerobot-train's periodic evaluation run on
@@ -53,7 +53,7 @@ PI0_BASE = "lerobot/pi0_base"
 PI0_TOKENIZER = "google/paligemma-3b-pt-224"
 DIFFUSION_IMAGE_SIZE = (240, 320)
 COMPACT_IMAGE_SIZE = (120, 160)
-COMPACT_MODES = ("head_wrist", "fixed_wrist")  # the paper's headcam and fixedcam conditions (reference §9)
+COMPACT_MODES = ("head_wrist", "fixed_wrist")  # the paper's headcam and fixedcam conditions (docs/reference.md §1)
 PI0_IMAGE_SIZE = (480, 640)  # pi0 resizes and pads every camera to 224x224 itself
 CHUNK, EXECUTED = 16, 8
 COMPACT_CHUNK, COMPACT_EXECUTED = 20, 10

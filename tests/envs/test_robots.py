@@ -1,4 +1,4 @@
-"""Model facts from reference/robots_objects_physics.md §1 survive the procedural build."""
+"""Model facts from docs/reference.md §12 survive the procedural build."""
 
 import math
 

@@ -1,6 +1,8 @@
 """The eight TAVIS tasks: layouts within their split's ranges, success rules, prompts, blocked camera, init pose."""
 
 import itertools
+import re
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -11,14 +13,15 @@ from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.env import WARM_UP_HEAD_STD_RAD, WARM_UP_POSITION_STD_M, TavisEnv, warm_up_action
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.robots import make_robot
-from lerobot_tavis.envs.tasks import multi_shelf_scan, peeking_box
-from lerobot_tavis.envs.tasks.catalog import SUITES, TASKS, suite_tasks
+from lerobot_tavis.envs.tasks import catalog, multi_shelf_scan, peeking_box
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SUITES, TASKS, suite_tasks
 from lerobot_tavis.envs.tasks.clutter_pick_lift import footprint
 from lerobot_tavis.envs.tasks.layout import CONTACT_GAP_M, Pose2D, overlaps
 from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.world import build_world
 
-TAVIS_TASKS = [t for suite in SUITES for t in suite_tasks(suite)]
+TAVIS_TASKS = list(BENCHMARK_TASKS)
+ROOT = Path(__file__).resolve().parents[2]
 VARIANTS = ("id", "ood_spatial")
 SEEDS = 200
 
@@ -45,12 +48,37 @@ def _has(model, body):
         return False
 
 
-def test_suites_hold_the_reference_tasks():
-    assert suite_tasks("tavis_head") == ("conditional_pick", "wait_then_act", "clutter_pick_cube",
-                                         "clutter_pick_lift", "multi_shelf_scan")
-    assert suite_tasks("tavis_hands") == ("peeking_box", "occluded_reach", "blocked_clutter_pick_cube")
+def _table_rows(path: Path) -> list[list[str]]:
+    """The cells of every Markdown table row of `path`, header and rule rows included."""
+    return [[cell.strip() for cell in line.strip().strip("|").split("|")]
+            for line in path.read_text().splitlines() if line.startswith("|")]
+
+
+def test_suites_hold_the_reference_tasks_and_the_docs_list_the_registry():
+    reference_suites = {row[0]: {name.strip() for name in row[1].split(",")}
+                        for row in _table_rows(ROOT / "docs" / "reference.md") if row[0].startswith("TAVIS-")}
+    assert {suite: set(suite_tasks(suite)) for suite in SUITES} == {
+        f"tavis_{name[len('TAVIS-'):].lower()}": tasks for name, tasks in reference_suites.items()}
     for name in TAVIS_TASKS:
         assert TASKS[name].splits == ("id", "ood_spatial", "ood_init_pose", "ood_visual")
+    documented = [(row[0], row[1]) for row in _table_rows(ROOT / "docs" / "tasks.md") if row[0] in SUITES]
+    assert documented == [(TASKS[name].suite, name) for name in TAVIS_TASKS]
+    (readme_list,) = re.findall(r"The eight tasks \(([^)]*)\)", (ROOT / "README.md").read_text())
+    assert re.findall(r"`(\w+)`", readme_list) == TAVIS_TASKS
+
+
+def test_the_docs_state_the_success_thresholds_of_the_code():
+    """docs/tasks.md and the demonstrators' comments write each threshold as "`NAME` = value"; every value is the
+    constant's, and the shelf's threshold is its front edge less 3 cm."""
+    constants = {name: getattr(catalog, name) for name in
+                 ("LIFT_HEIGHT_M", "HIGH_LIFT_HEIGHT_M", "SHELF_EXIT_X_M", "MAX_SUCCESS_SPEED_M_S")}
+    texts = [ROOT / "docs" / "tasks.md", *sorted((ROOT / "lerobot_tavis" / "experts").glob("*.py"))]
+    stated = [(name, float(value)) for path in texts
+              for name, value in re.findall(r"`([A-Z_]+)` = (\d+(?:\.\d+)?)", path.read_text())]
+    assert {name for name, _ in stated} == set(constants)
+    for name, value in stated:
+        assert value == pytest.approx(constants[name], abs=1e-9), name
+    assert catalog.SHELF_EXIT_X_M == multi_shelf_scan.SHELF_X - multi_shelf_scan.SHELF_DEPTH / 2 - 0.03
 
 
 @pytest.mark.parametrize("variant", VARIANTS)

@@ -1,6 +1,6 @@
 """Fourier GR1T2 upper body with two Robotiq-2F-85-like grippers, built from primitives.
 
-Kinematics from the official URDF (reference/robots_objects_physics.md §1.2): pelvis (the canonical origin) at
+Kinematics from the official URDF (docs/reference.md §12): pelvis (the canonical origin) at
 world z 0.93, waist locked, arms in the official joint order with the 24.8° roll of the shoulder-pitch frame, neck
 roll -> pitch -> yaw. Link frames coincide with the pelvis frame at the zero pose (arms hanging down), which makes
 the hand frame follow the package convention (approach along -z) with no extra mount rotation.
@@ -44,7 +44,8 @@ class GR1T2(Robot):
     name = "gr1t2"
     visual_assets = "gr1t2"
     canonical_origin = (0.0, 0.0, PELVIS_HEIGHT_M)
-    rest_posture_seed = {  # the reference's rest joints (§3.2); they already hold the hands at the rest position
+    # The reference's rest joints (docs/reference.md §5); they already hold the hands at the rest position.
+    rest_posture_seed = {
         "left": (-0.335, -0.008, 0.046, -1.778, 0.0, 0.0, 0.0),
         "right": (-0.335, 0.008, -0.047, -1.778, 0.0, 0.0, 0.0),
     }

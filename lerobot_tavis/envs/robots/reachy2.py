@@ -1,6 +1,6 @@
 """Pollen Reachy 2 upper body on a fixed base, with parallel grippers, built from primitives.
 
-Kinematics from Pollen's public model (reference/robots_objects_physics.md §1.3): base on the floor, torso at
+Kinematics from Pollen's public model (docs/reference.md §12): base on the floor, torso at
 z 0.996, shoulders at ±0.20 m with frames tilted 15° from horizontal and yawed 10°, Orbita joints whose axes meet
 in one point (upper arm 0.28 m, forearm 0.28 m), neck roll/pitch/yaw through one point pitched 10° forward. The
 hand frame is the wrist's shoulder-aligned frame, which hangs along -z at the zero pose like the package convention.

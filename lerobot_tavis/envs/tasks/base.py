@@ -24,9 +24,8 @@ import numpy as np
 
 from lerobot_tavis.envs.objects import OBJECT_NAMES, YCB_OBJECTS, add_prop
 from lerobot_tavis.envs.placement import body_speed
-from lerobot_tavis.envs.tasks.catalog import TaskInfo
+from lerobot_tavis.envs.tasks.catalog import LIFT_HEIGHT_M, MAX_SUCCESS_SPEED_M_S, TaskInfo
 
-MAX_SUCCESS_SPEED_M_S = 1.0
 # `evaluate` reports measured quantities to the millimetre (mm/s): bit-level differences between runs of the same
 # episode (a policy's arithmetic in another process, say) stay out of the episode log. Decisions use exact values.
 MEASURE_DECIMALS = 3
@@ -55,7 +54,7 @@ class TargetFacts(EpisodeFacts):
 
 class Task(abc.ABC):
     info: ClassVar[TaskInfo]
-    VARIANTS: ClassVar[dict[str, Any]]  # "id" and "ood_spatial" presets (reference §2)
+    VARIANTS: ClassVar[dict[str, Any]]  # "id" and "ood_spatial" presets (docs/reference.md §4)
     has_table: ClassVar[bool] = True
     blacked_out_cameras: ClassVar[frozenset[str]] = frozenset()
 
@@ -106,7 +105,7 @@ class Task(abc.ABC):
 class YcbTask(Task, abc.ABC):
     """A task with the five YCB objects (those not used in an episode wait off-stage) and one target prop."""
 
-    success_height_m: ClassVar[float] = 1.2
+    success_height_m: ClassVar[float] = LIFT_HEIGHT_M
 
     def __init__(self, variant: str = "id"):
         super().__init__(variant)
@@ -132,7 +131,8 @@ class YcbTask(Task, abc.ABC):
 def lift_conditions(model: mujoco.MjModel, data: mujoco.MjData, body: str,
                     height_m: float) -> dict[str, bool | float]:
     """The reference's lift rule, part by part: the body's origin above `height_m` (world z; `target_lifted`) and
-    slower than 1 m/s (`target_slow`), with the measured height (m) and speed (m/s), to `MEASURE_DECIMALS`."""
+    slower than `MAX_SUCCESS_SPEED_M_S` (`target_slow`), with the measured height (m) and speed (m/s), to
+    `MEASURE_DECIMALS`."""
     height = float(data.xpos[model.body(body).id][2])
     speed = body_speed(model, data, body)
     lifted, slow = height > height_m, speed < MAX_SUCCESS_SPEED_M_S

@@ -1,10 +1,11 @@
 """The task registry: each task's suite, prompts, success rule, splits, task class and demonstrator, readable
 without MuJoCo.
 
-`TASKS` below is the one place a task is declared. Its task class (one module each next to this file) and its
-demonstrator (`lerobot_tavis.experts`) are named by import path and imported only when an env or a demonstrator is
-built, so CLIs and configs validate names and expand suites without loading a simulator. Tasks from outside the
-package join with `register_task` (docs/extending.md).
+`TASKS` below is the one place a task is declared, with the thresholds of its success rule as named constants
+that the task class's `evaluate`, the rule's text here and docs/tasks.md all use. Its task class (one module each
+next to this file) and its demonstrator (`lerobot_tavis.experts`) are named by import path and imported only when an
+env or a demonstrator is built, so CLIs and configs validate names and expand suites without loading a simulator.
+Tasks from outside the package join with `register_task` (docs/extending.md).
 """
 
 from __future__ import annotations
@@ -89,7 +90,14 @@ SHELF_PROMPTS = {
                     "Look through the shelves, find the pudding box, and take it."),
 }
 CUBE_PROMPT = "Find the red cube and pick it up."
-LIFT_RULE = "the {what}'s origin is above {z} m and moving slower than 1 m/s"
+
+# Success thresholds (world frame; docs/reference.md §4). The target's origin must be:
+LIFT_HEIGHT_M = 1.2  # above this z: the Head tasks that lift, and blocked_clutter_pick_cube
+HIGH_LIFT_HEIGHT_M = 1.25  # above this z: peeking_box and occluded_reach
+SHELF_EXIT_X_M = 0.52 - 0.11 / 2 - 0.03  # 0.435, nearer than this x: the shelf's front edge (x 0.52, depth 0.11) - 3 cm
+MAX_SUCCESS_SPEED_M_S = 1.0  # and slower than this (m/s), in every task
+SPEED_RULE = f"moving slower than {MAX_SUCCESS_SPEED_M_S:g} m/s"
+LIFT_RULE = "the {what}'s origin is above {z} m and " + SPEED_RULE
 
 TASKS_PKG, HEAD_EXPERTS, HANDS_EXPERTS = ("lerobot_tavis.envs.tasks", "lerobot_tavis.experts.head_tasks",
                                           "lerobot_tavis.experts.hands_tasks")
@@ -100,33 +108,33 @@ TASKS: dict[str, TaskInfo] = {
         TaskInfo("conditional_pick", "tavis_head",
                  ("Look at the card. If it is red, pick the object on the left. If it is green, pick the object on "
                   "the right.",),
-                 LIFT_RULE.format(what="target (left object if the card is red, right if green)", z=1.2),
+                 LIFT_RULE.format(what="target (left object if the card is red, right if green)", z=LIFT_HEIGHT_M),
                  task_class=f"{TASKS_PKG}.conditional_pick:ConditionalPick",
                  demonstrator=f"{HEAD_EXPERTS}:ConditionalPickExpert"),
         TaskInfo("wait_then_act", "tavis_head",
                  ("Watch the red light. When it turns green, pick up the object.",),
-                 "once the light is green: " + LIFT_RULE.format(what="object", z=1.2),
+                 "once the light is green: " + LIFT_RULE.format(what="object", z=LIFT_HEIGHT_M),
                  task_class=f"{TASKS_PKG}.wait_then_act:WaitThenAct", demonstrator=f"{HEAD_EXPERTS}:WaitThenActExpert"),
-        TaskInfo("clutter_pick_cube", "tavis_head", (CUBE_PROMPT,), LIFT_RULE.format(what="red cube", z=1.2),
+        TaskInfo("clutter_pick_cube", "tavis_head", (CUBE_PROMPT,), LIFT_RULE.format(what="red cube", z=LIFT_HEIGHT_M),
                  task_class=f"{TASKS_PKG}.clutter_pick_cube:ClutterPickCube",
                  demonstrator=f"{HEAD_EXPERTS}:ClutterExpert"),
         TaskInfo("clutter_pick_lift", "tavis_head", tuple(p for ps in LIFT_PROMPTS.values() for p in ps),
-                 LIFT_RULE.format(what="named object", z=1.2),
+                 LIFT_RULE.format(what="named object", z=LIFT_HEIGHT_M),
                  task_class=f"{TASKS_PKG}.clutter_pick_lift:ClutterPickLift",
                  demonstrator=f"{HEAD_EXPERTS}:ClutterExpert"),
         TaskInfo("multi_shelf_scan", "tavis_head", tuple(p for ps in SHELF_PROMPTS.values() for p in ps),
-                 "the named object's origin is closer than x = 0.435 m (out of the shelf) and moving slower than "
-                 "1 m/s",
+                 f"the named object's origin is closer than x = {SHELF_EXIT_X_M:.3f} m (out of the shelf) and "
+                 + SPEED_RULE,
                  task_class=f"{TASKS_PKG}.multi_shelf_scan:MultiShelfScan", demonstrator=f"{HEAD_EXPERTS}:ShelfExpert"),
         TaskInfo("peeking_box", "tavis_hands", ("Retrieve the object from inside the box.",),
-                 LIFT_RULE.format(what="object", z=1.25),
+                 LIFT_RULE.format(what="object", z=HIGH_LIFT_HEIGHT_M),
                  task_class=f"{TASKS_PKG}.peeking_box:PeekingBox", demonstrator=f"{HANDS_EXPERTS}:PeekingBoxExpert"),
         TaskInfo("occluded_reach", "tavis_hands", ("Reach around the screen and pick up the object behind it.",),
-                 LIFT_RULE.format(what="object", z=1.25),
+                 LIFT_RULE.format(what="object", z=HIGH_LIFT_HEIGHT_M),
                  task_class=f"{TASKS_PKG}.occluded_reach:OccludedReach",
                  demonstrator=f"{HANDS_EXPERTS}:OccludedReachExpert"),
         TaskInfo("blocked_clutter_pick_cube", "tavis_hands", (CUBE_PROMPT,),
-                 LIFT_RULE.format(what="red cube", z=1.2) + "; the head camera image is black",
+                 LIFT_RULE.format(what="red cube", z=LIFT_HEIGHT_M) + "; the head camera image is black",
                  task_class=f"{TASKS_PKG}.blocked_clutter_pick_cube:BlockedClutterPickCube",
                  demonstrator=f"{HANDS_EXPERTS}:BlockedClutterExpert"),
         TaskInfo("tabletop", "sandbox", ("Look at the objects on the table.",),

@@ -1,6 +1,6 @@
 """Sampling object layouts on the table as densely as the reference does, without objects inside each other.
 
-The reference's sampler (IsaacLab's, reference/tavis_benchmark.md §2.1) places objects one after another: for each,
+The reference's sampler (IsaacLab's, docs/reference.md §4) places objects one after another: for each,
 it draws up to 5000 uniform poses and takes the first whose centre is farther than the split's minimum separation
 from every centre placed so far; when none is, it takes the 5000th pose, separation or not (about 30% of
 clutter_pick_cube `id` resets), which packs the clutter tighter than the separation says. It checks centres only,

@@ -1,7 +1,7 @@
 """TAVIS-Head multi_shelf_scan: five objects in six slots of a three-shelf unit; take the named one out.
 
-No table. Success: the target's origin is nearer than x = 0.435 m (out of the shelf) and slower than 1 m/s; no
-height condition (reference §2.5).
+No table. Success: the target's origin is nearer than x = `catalog.SHELF_EXIT_X_M` (out of the shelf) and slower
+than `MAX_SUCCESS_SPEED_M_S`; no height condition (docs/reference.md §4).
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import numpy as np
 from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.placement import body_speed
-from lerobot_tavis.envs.tasks.base import MAX_SUCCESS_SPEED_M_S, MEASURE_DECIMALS, YcbTask
-from lerobot_tavis.envs.tasks.catalog import SHELF_PROMPTS, TASKS
+from lerobot_tavis.envs.tasks.base import MEASURE_DECIMALS, YcbTask
+from lerobot_tavis.envs.tasks.catalog import MAX_SUCCESS_SPEED_M_S, SHELF_EXIT_X_M, SHELF_PROMPTS, TASKS
 
 SHELF_X, SHELF_DEPTH, SHELF_WIDTH = 0.52, 0.11, 0.70
 BOARD_THICKNESS = 0.02
@@ -27,8 +27,7 @@ SLOT_X_CLAMP = (0.485, 0.555)
 SLOT_Y_CLAMP = (-0.32, 0.32)
 INNER_X = (SHELF_X - SHELF_DEPTH / 2, SHELF_X + SHELF_DEPTH / 2 - 0.005)  # open front .. back panel
 INNER_Y = (-SHELF_WIDTH / 2, SHELF_WIDTH / 2)
-SUCCESS_X = SHELF_X - SHELF_DEPTH / 2 - 0.03  # 0.435 m
-# This task's own key light (reference §2.5): from behind-left of the robot into the shelf's open front.
+# This task's own key light (docs/reference.md §4): from behind-left of the robot into the shelf's open front.
 KEY_LIGHT_DIR = (0.643, -0.236, -0.728)
 KEY_LIGHT_INTENSITY = 1000.0
 # Light wood, as the shelf appears in the reference's renders (its base colour (0.55, 0.35, 0.20) is lit there far
@@ -88,10 +87,10 @@ class MultiShelfScan(YcbTask):
             placement.set_free_pose(model, data, name, (x, y, placement.standing_z(name, surface)), yaw)
 
     def evaluate(self, data) -> dict[str, bool | float]:
-        """`target_out_of_shelf`: the origin nearer than x = 0.435 m (`target_x_m`); `target_slow`: slower than
-        1 m/s (`target_speed_m_s`); measures to `MEASURE_DECIMALS`."""
+        """`target_out_of_shelf`: the origin nearer than x = `SHELF_EXIT_X_M` (`target_x_m`); `target_slow`:
+        slower than `MAX_SUCCESS_SPEED_M_S` (`target_speed_m_s`); measures to `MEASURE_DECIMALS`."""
         x = float(data.xpos[self._model.body(self.target).id][0])
         speed = body_speed(self._model, data, self.target)
-        out, slow = x < SUCCESS_X, speed < MAX_SUCCESS_SPEED_M_S
+        out, slow = x < SHELF_EXIT_X_M, speed < MAX_SUCCESS_SPEED_M_S
         return {"success": out and slow, "target_out_of_shelf": out, "target_slow": slow,
                 "target_x_m": round(x, MEASURE_DECIMALS), "target_speed_m_s": round(speed, MEASURE_DECIMALS)}
