@@ -208,8 +208,45 @@ def _train(options: TrainOptions) -> None:
     sys.exit(subprocess.call(command))
 
 
-from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError, surroundings_message
-from lerobot_tavis.tempdir import use_private_tempdir
+def version_line() -> str:
+    """`tavis --version`: this package's version and those of the packages a bug report needs, read from their
+    installed metadata (nothing is imported)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    def installed(name: str) -> str:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "not installed"
+
+    others = ", ".join(f"{name} {installed(name)}" for name in ("lerobot", "mujoco", "torch"))
+    return f"tavis (lerobot_env_tavis) {installed('lerobot_env_tavis')}; {others}"
+
+
+def _check_dataset_root(preset: Path, lerobot_args: tuple[str, ...]) -> None:
+    """The dataset a training reads must be on disk unless it is a Hub dataset: a missing --dataset.root is one line
+    here, not lerobot-train's failed Hub download of the preset's placeholder `local/...` repo id. The root is
+    --dataset.root, else LeRobot's default `$HF_LEROBOT_HOME/<repo_id>`."""
+    import json
+
+    from huggingface_hub.constants import HF_HOME
+
+    dataset = argparse.ArgumentParser(add_help=False, allow_abbrev=False)  # LeRobot's --a.b=x and --a.b x alike
+    dataset.add_argument("--dataset.root", dest="root")
+    dataset.add_argument("--dataset.repo_id", dest="repo_id")
+    given, _ = dataset.parse_known_args(lerobot_args)
+    repo_id = given.repo_id or json.loads(preset.read_text())["dataset"]["repo_id"]
+    root = given.root
+    if root is not None:
+        if not (Path(root) / "meta" / "info.json").is_file():
+            raise PathNotFoundError(f"--dataset.root {root} holds no LeRobotDataset (no meta/info.json): pass the "
+                                    "folder `tavis convert --root` wrote")
+    elif repo_id.startswith("local/"):
+        home = Path(os.environ.get("HF_LEROBOT_HOME", Path(HF_HOME) / "lerobot")).expanduser()
+        if not (home / repo_id / "meta" / "info.json").is_file():
+            raise InputError(f"no --dataset.root: pass --dataset.root=<the folder `tavis convert --root` wrote> (the "
+                             f"dataset {repo_id} is local, not on the Hub), or --dataset.repo_id=<owner>/<name> of a "
+                             "dataset on the Hub")
 
 
 def build_parser() -> argparse.ArgumentParser:

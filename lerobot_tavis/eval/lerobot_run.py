@@ -9,8 +9,8 @@ the sub-envs that draw frames (`TavisEnvConfig.filmed_envs`); it writes the same
 `filmed_envs=0` no frame is rendered for a video at all.
 
 LeRobot's own progress bars (one per batch and one per rollout, nested) are off: the caller draws one bar for its
-whole run (`tavis eval`'s `cell_runs`). Its rollout converts each step's camera images from uint8 to float on the device instead of the CPU
-(`images_converted_on`), to the same values as LeRobot's own conversion. A process that runs
+whole run (`tavis eval`'s `cell_runs`). Its rollout converts each step's camera images from uint8 to float on the
+device instead of the CPU (`images_converted_on`), to the same values as LeRobot's own conversion. A process that runs
 one task after another (`tavis eval --policy`'s jobs) can keep its env workers between runs (`keep_workers`): the
 next run's task and split are built in the same worker processes.
 """

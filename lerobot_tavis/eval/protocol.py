@@ -33,7 +33,8 @@ from lerobot_tavis.envs.tasks.catalog import (BENCHMARK_TASKS, PROTOCOL_SPLITS, 
 from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.eval.cell_runs import played_tasks, run_cells
 from lerobot_tavis.eval.report import EVAL_INFO_NAME, read_eval_info, write_report
-from lerobot_tavis.eval.run_identity import RUN_FIELD, RUN_FILE, difference_text, differences, read_identity, run_identity
+from lerobot_tavis.eval.run_identity import (RUN_FIELD, RUN_FILE, difference_text, differences, read_identity,
+                                             run_identity)
 from lerobot_tavis.locking import exclusive_output
 
 START_SEED = 1000

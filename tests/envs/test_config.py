@@ -260,5 +260,72 @@ def test_an_explicit_episode_log_wins_and_without_either_there_is_none(tmp_path,
     assert "no episode log" in caplog.text and "--env.episode_log" in caplog.text
 
 
-import warnings
-from dataclasses import dataclass
+def _checkpoint(path, cameras=("head", "left_wrist", "right_wrist"), image_size=(120, 160), env=None):
+    """A checkpoint's config files (no weights): its policy reads `cameras` at `image_size`."""
+    import json
+
+    path.mkdir(parents=True)
+    images = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, *image_size]} for camera in cameras}
+    (path / "config.json").write_text(json.dumps({"type": "act", "input_features": images}))
+    if env is not None:
+        (path / "train_config.json").write_text(json.dumps({"env": env}))
+    return str(path)
+
+
+def test_lerobot_eval_renders_what_the_policy_of_its_command_line_reads(tmp_path, caplog):
+    """`lerobot-eval --policy.path=<checkpoint> --env.type=tavis`: settings left out take the checkpoint's."""
+    checkpoint = _checkpoint(tmp_path / "ckpt", ("fixed", "left_wrist", "right_wrist"), (96, 128),
+                             env={"type": "tavis", "robot": "reachy2", "camera_mode": "fixed_wrist"})
+    config = TavisEnvConfig(task="wait_then_act")
+    with caplog.at_level("INFO"):
+        config.match_command_line_policy([f"--policy.path={checkpoint}", "--env.type=tavis"])
+    assert (config.robot, config.camera_mode, tuple(config.image_size)) == ("reachy2", "fixed_wrist", (96, 128))
+    assert config.features["pixels/fixed"].shape == (96, 128, 3) and "pixels/head" not in config.features
+    assert "the env takes the checkpoint's robot reachy2, camera_mode fixed_wrist, image_size 96x128" in caplog.text
+
+
+def test_a_setting_given_to_lerobot_eval_wins_with_a_warning(tmp_path, caplog):
+    checkpoint = _checkpoint(tmp_path / "ckpt")
+    config = TavisEnvConfig(task="wait_then_act", image_size=(480, 640))  # the default, but on the command line
+    with caplog.at_level("WARNING"):
+        config.match_command_line_policy([f"--policy.path={checkpoint}", "--env.image_size=[480, 640]"])
+    assert tuple(config.image_size) == (480, 640)
+    assert ("the policy was trained on 120x160 images; --env.image_size asks for 480x640 (leave --env.image_size "
+            "out to use the checkpoint's)") in caplog.text
+
+
+def test_lerobot_eval_refuses_a_camera_mode_without_the_policys_cameras(tmp_path):
+    checkpoint = _checkpoint(tmp_path / "ckpt")
+    config = TavisEnvConfig(task="wait_then_act", camera_mode="fixed_only")
+    with pytest.raises(ValueError, match="the policy reads the cameras head, left_wrist, right_wrist, camera mode "
+                                         "fixed_only renders fixed: use --env.camera_mode head_wrist"):
+        config.match_command_line_policy([f"--policy.path={checkpoint}"])
+
+
+def test_without_a_policy_on_the_command_line_the_settings_stay(tmp_path):
+    config = TavisEnvConfig(task="wait_then_act", image_size=(24, 32))
+    config.match_command_line_policy(["--env.type=tavis"])
+    assert tuple(config.image_size) == (24, 32)
+
+
+@dataclass
+class _Cli:
+    env: EnvConfig
+
+
+@pytest.mark.parametrize("args,shadows", [([], True), (["--env.shadows=false"], False)])
+def test_shadows_are_on_unless_the_command_line_turns_them_off_and_the_log_says_which(tmp_path, args, shadows):
+    config = draccus.parse(_Cli, args=["--env.type=tavis", "--env.task=wait_then_act", "--env.camera_mode=fixed_only",
+                                       "--env.image_size=[16,16]", "--env.episode_length_s=0.1",
+                                       f"--env.episode_log={tmp_path / 'episodes.jsonl'}", *args]).env
+    assert config.shadows is shadows
+    vec = config.create_envs(n_envs=1)["tavis_head"][0]
+    vec.reset(seed=[0], options={NEW_ROLLOUT_OPTION: True})
+    assert vec.envs[0].unwrapped.shadows is shadows
+    model = vec.envs[0].unwrapped.model
+    assert bool(model.light_castshadow.any()) is shadows
+    for _ in range(2):
+        vec.step(canonical.rest_action()[None])
+    vec.close()
+    (record,) = [json.loads(line) for line in (tmp_path / "episodes.jsonl").read_text().splitlines()]
+    assert record["shadows"] is shadows
