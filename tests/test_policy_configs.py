@@ -176,9 +176,7 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
 
 def test_pi0_presets_say_clearly_what_is_missing_offline(tmp_path):
     env = {**os.environ, "HF_HUB_OFFLINE": "1", "HF_HOME": str(tmp_path / "hf"), "HF_TOKEN": ""}
-    dataset = tmp_path / "dataset"  # checked first: it only needs to look like one
-    (dataset / "meta").mkdir(parents=True)
-    (dataset / "meta" / "info.json").write_text("{}")
+    dataset = _dataset_info(tmp_path / "dataset", ("head",), (224, 224))  # checked first: need only look like one
     result = subprocess.run([sys.executable, "-m", "lerobot_tavis.cli", "train", "pi0_head_only", "--steps=1",
                              f"--dataset.root={dataset}"],
                             capture_output=True, text=True, env=env, timeout=120)

@@ -4,14 +4,13 @@
 
 `--figure` is the paper's overview figure (1654x787 px), whose TAVIS-Head panel shows each task's head and fixed
 camera views on GR1T2. Top row: its thumbnails of TASKS (head, then fixed, for each task); bottom row: ours, GR1T2
-at the grasp of seed 0's demonstrator episode (GRASP_DELAY_STEPS after the gripper starts closing), as the figure
+at the grasp of seed 0's demonstrator episode (the gallery's grasp still), as the figure
 shows a hand at an object.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 import cv2
@@ -23,7 +22,6 @@ HEAD_ROWS, FIXED_ROWS = (181, 270), (291, 380)  # the figure's thumbnail rows (p
 TASK_COLUMNS = {"conditional_pick": (197, 316), "clutter_pick_cube": (350, 469)}  # a task's thumbnail column (px)
 TASKS = tuple(TASK_COLUMNS)
 PANEL_SIZE = (120, 160)
-GRASP_DELAY_STEPS = 8
 
 
 def figure_panels(path: Path) -> list[np.ndarray]:
@@ -45,26 +43,13 @@ def figure_panels(path: Path) -> list[np.ndarray]:
 
 
 def our_panels() -> list[np.ndarray]:
-    """GR1T2's head and fixed views of TASKS at the demonstrator's grasp, seed 0."""
-    os.environ.setdefault("MUJOCO_GL", "egl")
-    from lerobot_tavis.envs.env import TavisEnv
-    from lerobot_tavis.experts.registry import make_expert
+    """GR1T2's head and fixed views of TASKS at the demonstrator's grasp, seed 0 (the gallery's grasp stills)."""
+    from lerobot_tavis.gallery import capture_stills
 
     panels = []
     for task in TASKS:
-        env = TavisEnv(task, "gr1t2", image_size=PANEL_SIZE, cameras=("head", "fixed"))
-        obs, _ = env.reset(seed=0)
-        expert = make_expert(env, 0)
-        expert.reset()
-        closed_for = -1
-        for _ in range(400):
-            obs, _, terminated, truncated, info = env.step(expert.act())
-            if closed_for >= 0 or max(info["applied_action"][17:19]) > 0:
-                closed_for += 1
-            if closed_for >= GRASP_DELAY_STEPS or terminated or truncated:
-                break
-        panels += [obs["pixels"]["head"], obs["pixels"]["fixed"]]
-        env.close()
+        grasp = capture_stills(task, "gr1t2", image_size=PANEL_SIZE).grasp
+        panels += [grasp["head"], grasp["fixed"]]
     return panels
 
 

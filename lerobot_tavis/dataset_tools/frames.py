@@ -14,7 +14,7 @@ from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.readers import expect, get, get_integer, read_json, read_parquet
 
 INFO = "meta/info.json"
-FRAME_COLUMNS = ("episode_index", "frame_index", "timestamp")  # what `episode_frames` needs in every data file
+FRAME_COLUMNS = ("episode_index", "frame_index", "timestamp")  # what a replay needs in every data file
 
 
 def dataset_info(root: str | Path) -> dict:
@@ -50,9 +50,9 @@ def check_files(root: str | Path) -> None:
             read_parquet(path)
 
 
-def episode_frames(root: str | Path) -> dict:
+def episode_frames(root: str | Path, columns: tuple[str, ...] = FRAME_COLUMNS) -> dict:
     """Per episode index, its rows of the data files under `root` (a pandas DataFrame) sorted by `frame_index`;
-    each row also names its `data_file`."""
+    each row also names its `data_file`. A data file without one of `columns` is refused, naming it."""
     import pandas as pd
 
     paths = sorted((Path(root) / "data").rglob("*.parquet"))
@@ -61,7 +61,8 @@ def episode_frames(root: str | Path) -> dict:
     tables = []
     for path in paths:
         table = read_parquet(path).to_pandas()
-        missing = [column for column in FRAME_COLUMNS if column not in table.columns]
+        missing = [column for column in dict.fromkeys(("episode_index", "frame_index", *columns))
+                   if column not in table.columns]
         if missing:
             raise InputError(f"{path}: not a LeRobotDataset data file (no column {', '.join(missing)})")
         tables.append(table.assign(data_file=str(path)))

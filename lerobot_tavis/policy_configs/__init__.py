@@ -45,6 +45,7 @@ from lerobot_tavis.envs.modes import (BUILTIN_CAMERA_MODES, RENAMED_MODES, mode_
                                       resolve_camera_mode)
 from lerobot_tavis.errors import InputError
 from lerobot_tavis.policies.dataset_fit import UNRESIZED_POLICIES, check_dataset_images
+from lerobot_tavis.readers import read_json
 
 PRESET_DIR = Path(__file__).parent
 POLICIES = ("diffusion", "pi0")
@@ -174,8 +175,12 @@ def check_training_dataset(preset: Path, lerobot_args: Sequence[str]) -> None:
     info = Path(root) / "meta" / "info.json" if root else HF_LEROBOT_HOME / str(repo_id) / "meta" / "info.json"
     if not info.is_file():
         return
+    content = read_json(info)
+    features = content.get("features") if isinstance(content, dict) else None
+    if not isinstance(features, dict):
+        raise InputError(f"{info}: not a LeRobotDataset's info.json (no features object)")
     policy_type = parse_arg("policy.type", lerobot_args) or config["policy"]["type"]
-    check_dataset_images(config["policy"].get("input_features", {}), json.loads(info.read_text())["features"],
+    check_dataset_images(config["policy"].get("input_features", {}), features,
                          resizes=policy_type not in UNRESIZED_POLICIES)
 
 

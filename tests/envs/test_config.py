@@ -319,7 +319,7 @@ def test_shadows_are_on_unless_the_command_line_turns_them_off_and_the_log_says_
                                        "--env.image_size=[16,16]", "--env.episode_length_s=0.1",
                                        f"--env.episode_log={tmp_path / 'episodes.jsonl'}", *args]).env
     assert config.shadows is shadows
-    vec = config.create_envs(n_envs=1)["tavis_head"][0]
+    (vec,) = config.create_envs(n_envs=1)["tavis_head"].values()
     vec.reset(seed=[0], options={NEW_ROLLOUT_OPTION: True})
     assert vec.envs[0].unwrapped.shadows is shadows
     model = vec.envs[0].unwrapped.model

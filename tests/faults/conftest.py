@@ -40,20 +40,21 @@ def eval_root(tmp_path_factory):
     """`tavis eval --expert` of one conditional_pick episode with its `tavis report`, as the folder `step_100/` of
     a checkpoint curve's root (returned)."""
     root = tmp_path_factory.mktemp("faults_eval")
-    main(["eval", "--expert", "--tasks", "conditional_pick", "--episodes", "1", "--splits", "id", "--image-size",
-          "48x64", "--out", str(root / "step_100")])
+    main(["eval", "--expert", "--tasks", "conditional_pick", "--episodes", "1", "--splits", "id",
+          "--out", str(root / "step_100")])
     main(["report", str(root / "step_100")])
     return root
 
 
+def refused_line(argv: list[str]) -> str:
+    """Runs `tavis` in this process and returns the one line it exits with (SystemExit with a text: exit status 1)."""
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    message = exit_info.value.code
+    assert isinstance(message, str) and "\n" not in message
+    return message
+
+
 @pytest.fixture
 def refused():
-    """Runs `tavis` and returns the one line it exits with (SystemExit with a text: exit status 1)."""
-    def run(argv: list[str]) -> str:
-        with pytest.raises(SystemExit) as exit_info:
-            main(argv)
-        message = exit_info.value.code
-        assert isinstance(message, str) and "\n" not in message
-        return message
-
-    return run
+    return refused_line

@@ -10,18 +10,13 @@ import pytest
 
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.cli import main
+
+from .conftest import refused_line as _refused
 from lerobot_tavis.errors import FieldError, InputError, PathExistsError, PathNotFoundError, TavisError
 
 REPO_ID = "must be <owner>/<name> on the Hugging Face Hub"
 
 
-def _refused(argv: list[str]) -> str:
-    """The one-line message `tavis` exits with (SystemExit with a string is exit status 1)."""
-    with pytest.raises(SystemExit) as exit_info:
-        main(argv)
-    message = exit_info.value.code
-    assert isinstance(message, str) and "\n" not in message
-    return message
 
 
 @pytest.mark.parametrize("argv,message", [

@@ -19,7 +19,7 @@ from lerobot_tavis.errors import InputError
 from lerobot_tavis.eval.report import build_report
 from lerobot_tavis.locking import exclusive_output, lock_path
 
-EVAL = ["eval", "--tasks", "peeking_box", "--splits", "id", "--image-size", "24x32", "--episode-length-s", "1",
+EVAL = ["eval", "--tasks", "peeking_box", "--splits", "id", "--episode-length-s", "1",
         "--film-episodes", "0"]
 CELL = "tavis_hands__id"
 

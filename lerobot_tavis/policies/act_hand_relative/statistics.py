@@ -20,7 +20,7 @@ def hand_frame_statistics(root: str | Path, chunk_size: int) -> tuple[np.ndarray
     total = np.zeros(canonical.ACTION_DIM)
     total_squares = np.zeros(canonical.ACTION_DIM)
     count = 0
-    for rows in episode_frames(root).values():
+    for rows in episode_frames(root, columns=(ACTION_KEY, STATE_KEY)).values():
         actions, states = (torch.from_numpy(column_array(rows, key).astype(np.float64))
                            for key in (ACTION_KEY, STATE_KEY))
         for offset in range(min(chunk_size, len(actions))):
