@@ -16,6 +16,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from lerobot_tavis.atomic import hidden_stem
 from lerobot_tavis.errors import InputError
 
 
@@ -24,9 +25,10 @@ class OutputInUseError(InputError):
 
 
 def lock_path(directory: str | Path) -> Path:
-    """`.<name>.lock` beside `directory`, links resolved: two spellings of one directory share its lock."""
+    """`.<name>.lock` beside `directory`, links resolved: two spellings of one directory share its lock (a name too
+    long for that is shortened as `atomic.hidden_stem` does)."""
     directory = Path(directory).resolve()
-    return directory.with_name(f".{directory.name}.lock")
+    return directory.with_name(f".{hidden_stem(directory.name, len('lock'))}.lock")
 
 
 @contextmanager
@@ -51,8 +53,8 @@ def _locked(path: Path, directory: Path) -> int:
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-        except OSError as error:
-            raise InputError(f"cannot create the lock file {path}: {error.strerror}") from None
+        except OSError as error:  # reported as the output's own: read-only, a file in the way, a name too long
+            raise OSError(error.errno, error.strerror, str(directory)) from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
