@@ -17,8 +17,9 @@ from lerobot_tavis import canonical
 from lerobot_tavis.envs.transforms import matrix_from_quat, quat_multiply
 from lerobot_tavis.policies import register_policy_types
 from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import ACTHandRelativeConfig
-from lerobot_tavis.policies.act_hand_relative.modeling_act_hand_relative import EPS, ACTHandRelativePolicy
-from lerobot_tavis.policies.act_hand_relative.statistics import hand_frame_statistics
+from lerobot_tavis.policies.act_hand_relative.modeling_act_hand_relative import ACTHandRelativePolicy
+from lerobot_tavis.policies.hand_frame_statistics import hand_frame_statistics
+from lerobot_tavis.policies.hand_relative import EPS
 from lerobot_tavis.policies.hand_frame import to_hand_frame
 
 CHUNK = 4
@@ -67,7 +68,8 @@ def test_the_statistics_cover_every_chunk_action_inside_its_episode(dataset_root
                     relative[arm.quaternion] = turn * np.sign(turn[0])
                 values.append(relative)
     assert len(values) == sum(min(CHUNK, n - t) for n in (9, 3, 6) for t in range(n))
-    mean, std = hand_frame_statistics(root, CHUNK)
+    statistics = hand_frame_statistics(root, range(CHUNK))
+    mean, std = statistics["mean"], statistics["std"]
     np.testing.assert_allclose(mean, np.mean(values, axis=0), atol=1e-9)
     np.testing.assert_allclose(std, np.std(values, axis=0), atol=1e-9)
 
