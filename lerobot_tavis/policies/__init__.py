@@ -7,3 +7,4 @@ def register_policy_types() -> None:
     plugin module `lerobot_env_tavis`)."""
     import lerobot.policies  # noqa: F401
     import lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative  # noqa: F401
+    import lerobot_tavis.policies.diffusion_hand_relative.configuration_diffusion_hand_relative  # noqa: F401

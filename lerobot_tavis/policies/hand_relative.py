@@ -12,6 +12,7 @@ statistics are buffers, saved with the weights.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from contextlib import nullcontext
 from dataclasses import dataclass
 
@@ -97,7 +98,7 @@ class HandRelativeChunks:
     """Policy side (a base before the LeRobot policy class): statistics buffers, chunk conversion, time input, AMP
     precision. The subclass calls `_register_statistics` in its `__init__` after the LeRobot policy's."""
 
-    def _register_statistics(self, dataset_stats: dict | None, dataset_meta, chunk_offsets: range,
+    def _register_statistics(self, dataset_stats: dict | None, dataset_meta, chunk_offsets: Iterable[int],
                              state_statistics: bool = False) -> None:
         """Buffers `absolute_<a>`, `absolute_<b>`, `relative_<a>`, `relative_<b>` (<a>, <b>: mean, std or min, max,
         as actions are normalised), and with `state_statistics` `state_min`, `state_max`: NaN until filled from the

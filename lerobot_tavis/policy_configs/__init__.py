@@ -49,7 +49,7 @@ from lerobot_tavis.readers import read_json
 
 PRESET_DIR = Path(__file__).parent
 POLICIES = ("diffusion", "pi0")
-COMPACT_POLICIES = ("act", "act_hand_relative")
+COMPACT_POLICIES = ("act", "act_hand_relative", "diffusion_hand_relative")
 PI0_BASE = "lerobot/pi0_base"
 PI0_TOKENIZER = "google/paligemma-3b-pt-224"
 DIFFUSION_IMAGE_SIZE = (240, 320)
@@ -59,6 +59,7 @@ PI0_IMAGE_SIZE = (480, 640)  # pi0 resizes and pads every camera to 224x224 itse
 CHUNK, EXECUTED = 16, 8
 COMPACT_CHUNK, COMPACT_EXECUTED = 20, 10
 COMPACT_LR = 1e-4  # ACT's default peak, for the backbone as for the transformer
+COMPACT_DOWN_DIMS = [256, 512, 1024]  # the UNet of the earlier compact Diffusion Policy (docs/training.md)
 HAND_RELATIVE_BUDGET = {"batch_size": 128, "steps": 3200, "save_freq": 800}
 
 
@@ -85,11 +86,13 @@ def preset_path(name: str) -> Path:
 
 
 def build_preset(policy: str, camera_mode: str, compact: bool = False) -> dict:
-    """The partial TrainPipelineConfig of one preset (`compact`: the fast ACT baseline, not the reference's)."""
+    """The partial TrainPipelineConfig of one preset (`compact`: the fast baselines, not the reference's)."""
     if compact:
-        if policy not in COMPACT_POLICIES:
-            raise ValueError(f"compact presets are ACT presets ({', '.join(COMPACT_POLICIES)}), got policy {policy!r}")
-        return _compact_act(camera_mode) if policy == "act" else _compact_act_hand_relative(camera_mode)
+        builders = {"act": _compact_act, "act_hand_relative": _compact_act_hand_relative,
+                    "diffusion_hand_relative": _compact_diffusion_hand_relative}
+        if policy not in builders:
+            raise ValueError(f"compact presets are of {', '.join(COMPACT_POLICIES)}, got policy {policy!r}")
+        return builders[policy](camera_mode)
     image_size = DIFFUSION_IMAGE_SIZE if policy == "diffusion" else PI0_IMAGE_SIZE
     inputs = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, *image_size]}
               for camera in mode_cameras(camera_mode)}
@@ -148,6 +151,22 @@ def _compact_act_hand_relative(camera_mode: str) -> dict:
     preset = _compact_act(camera_mode)
     del preset["policy"]["input_features"]["observation.state"]
     preset["policy"] |= {"type": "act_hand_relative", "time_input": True}
+    return preset | HAND_RELATIVE_BUDGET
+
+
+def _compact_diffusion_hand_relative(camera_mode: str) -> dict:
+    """`diffusion_hand_relative` on the hand-frame ACT preset's cameras at 120x160 (resized to that size, not
+    cropped), time input, optimiser, schedule and budget: 2 observation steps, a horizon of 16 actions of which 8 are
+    executed, a UNet of `COMPACT_DOWN_DIMS` channels, a ResNet-18 from random weights with group norm, 10 DDIM steps
+    when acting. `observation.state` stays an input, as Diffusion Policy needs, and is read as the anchor; the network
+    sees none of it (`state_input` none, as the hand-frame ACT)."""
+    preset = _compact_act(camera_mode)
+    preset["policy"] = {"type": "diffusion_hand_relative", "input_features": preset["policy"]["input_features"],
+                        "n_obs_steps": 2, "horizon": CHUNK, "n_action_steps": EXECUTED,
+                        "drop_n_last_frames": CHUNK - EXECUTED - 2 + 1, "resize_shape": list(COMPACT_IMAGE_SIZE),
+                        "crop_shape": None, "down_dims": COMPACT_DOWN_DIMS, "pretrained_backbone_weights": None,
+                        "use_group_norm": True, "noise_scheduler_type": "DDIM", "num_inference_steps": 10,
+                        "optimizer_lr": COMPACT_LR, "push_to_hub": False, "time_input": True, "state_input": "none"}
     return preset | HAND_RELATIVE_BUDGET
 
 

@@ -5,8 +5,6 @@ lerobot-train and `tavis eval` path: tests/test_policy_configs.py)."""
 from types import SimpleNamespace
 
 import numpy as np
-import pyarrow as pa
-import pyarrow.parquet as pq
 import pytest
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
@@ -18,48 +16,23 @@ from lerobot_tavis.envs.transforms import matrix_from_quat, quat_multiply
 from lerobot_tavis.policies import register_policy_types
 from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import ACTHandRelativeConfig
 from lerobot_tavis.policies.act_hand_relative.modeling_act_hand_relative import ACTHandRelativePolicy
+from lerobot_tavis.policies.hand_frame import to_hand_frame
 from lerobot_tavis.policies.hand_frame_statistics import hand_frame_statistics
 from lerobot_tavis.policies.hand_relative import EPS
-from lerobot_tavis.policies.hand_frame import to_hand_frame
+from tests.policies.conftest import made_up_episode
 
 CHUNK = 4
 IMAGE = "observation.images.head"
 
 
-def _episode(rng, length: int) -> tuple[np.ndarray, np.ndarray]:
-    """Actions and states (length, 19) of a made-up episode: hands drifting and turning, the state lagging."""
-    actions = np.tile(canonical.rest_action(), (length, 1))
-    for arm in canonical.ARMS:
-        actions[:, arm.position] += np.cumsum(rng.normal(scale=0.01, size=(length, 3)), axis=0)
-        turns = rng.normal(scale=0.05, size=(length, 4)) + actions[:, arm.quaternion]
-        actions[:, arm.quaternion] = turns / np.linalg.norm(turns, axis=1, keepdims=True)
-    states = np.concatenate([actions[:1], actions[:-1]]) + rng.normal(scale=1e-3, size=actions.shape)
-    return actions, states
-
-
-@pytest.fixture
-def dataset_root(tmp_path):
-    """A dataset's data files as LeRobot writes them (two files, episodes in either order) and its episodes."""
-    rng = np.random.default_rng(0)
-    episodes = [_episode(rng, length) for length in (9, 3, 6)]
-    for name, indices in (("file-000", [2, 0]), ("file-001", [1])):
-        rows = [(e, f, episodes[e][0][f], episodes[e][1][f]) for e in indices for f in range(len(episodes[e][0]))]
-        vectors = {key: pa.FixedSizeListArray.from_arrays(pa.array(np.concatenate([row[i] for row in rows]),
-                                                                   pa.float32()), canonical.ACTION_DIM)
-                   for i, key in ((2, "action"), (3, OBS_STATE))}
-        table = pa.table({"episode_index": [row[0] for row in rows], "frame_index": [row[1] for row in rows],
-                          **vectors})
-        (tmp_path / "data/chunk-000").mkdir(parents=True, exist_ok=True)
-        pq.write_table(table, tmp_path / f"data/chunk-000/{name}.parquet")
-    return tmp_path, [(a.astype(np.float32).astype(float), s.astype(np.float32).astype(float)) for a, s in episodes]
-
-
-def test_the_statistics_cover_every_chunk_action_inside_its_episode(dataset_root):
+@pytest.mark.parametrize("offsets", [range(CHUNK), range(-1, CHUNK - 1)])  # ACT's; Diffusion Policy's
+def test_the_statistics_cover_every_chunk_action_inside_its_episode(dataset_root, offsets):
+    """Actions t+k (k in `offsets`) inside the episode, in the hand frame of the state at t."""
     root, episodes = dataset_root
     values = []
     for actions, states in episodes:
         for t in range(len(actions)):
-            for action in actions[t:t + CHUNK]:
+            for action in (actions[t + k] for k in offsets if 0 <= t + k < len(actions)):
                 relative = action.copy()
                 for arm in canonical.ARMS:
                     hand = states[t, arm.quaternion] / np.linalg.norm(states[t, arm.quaternion])  # made-up: not unit
@@ -67,11 +40,9 @@ def test_the_statistics_cover_every_chunk_action_inside_its_episode(dataset_root
                     turn = quat_multiply(hand * [1, -1, -1, -1], action[arm.quaternion])
                     relative[arm.quaternion] = turn * np.sign(turn[0])
                 values.append(relative)
-    assert len(values) == sum(min(CHUNK, n - t) for n in (9, 3, 6) for t in range(n))
-    statistics = hand_frame_statistics(root, range(CHUNK))
-    mean, std = statistics["mean"], statistics["std"]
-    np.testing.assert_allclose(mean, np.mean(values, axis=0), atol=1e-9)
-    np.testing.assert_allclose(std, np.std(values, axis=0), atol=1e-9)
+    statistics = hand_frame_statistics(root, offsets)
+    for key, reference in (("mean", np.mean), ("std", np.std), ("min", np.min), ("max", np.max)):
+        np.testing.assert_allclose(statistics[key], reference(values, axis=0), atol=1e-9)
 
 
 def _config(**fields) -> ACTHandRelativeConfig:
@@ -98,9 +69,10 @@ def policy(dataset_root):
 
 def _batch(rng, policy, size: int) -> tuple[dict, torch.Tensor]:
     """A training batch of `size` made-up chunks (normalised as LeRobot's processors do) and its absolute chunks."""
-    absolute = torch.tensor(np.stack([_episode(rng, CHUNK)[0] for _ in range(size)]), dtype=torch.float32)
+    absolute = torch.tensor(np.stack([made_up_episode(rng, CHUNK)[0] for _ in range(size)]), dtype=torch.float32)
     return {IMAGE: torch.rand(size, 3, 32, 32),
-            OBS_STATE: torch.tensor(np.stack([_episode(rng, 1)[1][0] for _ in range(size)]), dtype=torch.float32),
+            OBS_STATE: torch.tensor(np.stack([made_up_episode(rng, 1)[1][0] for _ in range(size)]),
+                                    dtype=torch.float32),
             ACTION: (absolute - policy.absolute_mean) / (policy.absolute_std + EPS),
             "action_is_pad": torch.zeros(size, CHUNK, dtype=torch.bool)}, absolute
 
@@ -169,8 +141,8 @@ def test_temporal_ensembling_averages_chunks_planned_from_different_states_as_ab
     policy = ACTHandRelativePolicy(_config(temporal_ensemble_coeff=0.01, n_action_steps=1), dataset_stats=stats,
                                    dataset_meta=SimpleNamespace(root=root, fps=20))
     rng = np.random.default_rng(3)
-    targets = torch.tensor(_episode(rng, 2 * CHUNK)[0], dtype=torch.float32).unsqueeze(0)  # (1, 8, 19)
-    states = torch.tensor(_episode(rng, CHUNK)[1], dtype=torch.float32)  # a different hand pose at each step
+    targets = torch.tensor(made_up_episode(rng, 2 * CHUNK)[0], dtype=torch.float32).unsqueeze(0)  # (1, 8, 19)
+    states = torch.tensor(made_up_episode(rng, CHUNK)[1], dtype=torch.float32)  # a different hand pose at each step
     step = iter(range(CHUNK))
 
     def planned(self, batch):  # the chunk from this step on, in the hand frame of this step's state
