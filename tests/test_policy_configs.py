@@ -183,14 +183,18 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
 
 def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_root, tmp_path):
     """`diffusion_hand_relative`, registered by this package and found by lerobot-train through the plugin, with its
-    time input (a feature no dataset holds): a few steps on the tiny dataset, then one short episode."""
+    time input (a feature no dataset holds): a few steps on the tiny dataset (its cameras at their size, one shared
+    image encoder), then one short episode."""
+    preset = json.loads(preset_path("diffusion_hand_relative_head_wrist_compact").read_text())
+    for feature in preset["policy"]["input_features"].values():
+        if feature["type"] == "VISUAL":
+            feature["shape"] = [3, *TINY]
+    (tmp_path / "preset.json").write_text(json.dumps(preset))
     env = {**os.environ, "MUJOCO_GL": "egl"}
-    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train",
-             f"--config_path={preset_path('diffusion_hand_relative_head_wrist_compact')}",
-             "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", "--env.task=conditional_pick",
-             "--policy.resize_shape=[24,32]", "--policy.down_dims=[16,32,64]", "--policy.num_inference_steps=2",
-             "--policy.device=cpu", "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0",
-             f"--output_dir={tmp_path / 'train'}"]
+    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={tmp_path / 'preset.json'}",
+             "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", *SMALL_RUN,
+             "--policy.use_separate_rgb_encoder_per_camera=false", "--steps=2", "--save_freq=2", "--batch_size=2",
+             "--num_workers=0", f"--output_dir={tmp_path / 'train'}"]
     subprocess.run(train, check=True, capture_output=True, env=env, timeout=600)
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
