@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact ACT policy -> evaluation
+# One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact policy -> evaluation
 # of every checkpoint (96 episodes each, Wilson intervals and GALT by `tavis eval`'s report).
 #
 #   benchmarks/train_baseline.sh pair|cell|data|train|eval|overfit
@@ -24,6 +24,9 @@
 # hand_relative: the `act_hand_relative_<CONDITION>_compact` preset, ACT whose chunks hold the arm poses in the frame
 # of the hand as measured when the chunk is planned, observation.state read as that anchor alone, with the time
 # since the episode began as an input; its own budget unless set: STEPS 3200, SAVE_FREQ 800, BATCH 128),
+# POLICY (act; diffusion: with ACTIONS=hand_relative, the only actions it takes, the
+# `diffusion_hand_relative_<CONDITION>_compact` preset, Diffusion Policy denoising horizons in the hand frame on the
+# same budget, its network seeing no state, with the time input; TRAIN_S 1500 s unless set),
 # GPUS (1; N > 1, not with `pair`: `train` runs lerobot-train data-parallel in N processes of `accelerate launch`,
 # one per visible GPU, each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS
 # and SAVE_FREQ by N for the one-GPU budget), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
@@ -36,12 +39,12 @@
 # - cell: the whole cell within one 30-minute GPU slot: data, then STEPS (4800; ACTIONS=hand_relative: 3200) steps of
 #   BATCH 128 with SAVE_FREQ 1600 (800) unless set (loaders: WORKERS - 2; the preset anneals the lr to 0 at the last
 #   step; about 13 minutes with 16 cores and an evaluation beside, 10 for hand_relative; TRAIN_S, 960 s, only guards
-#   the slot), the checkpoints evaluated at low CPU priority as they appear, and those left after training ends side
-#   by side.
+#   the slot; POLICY=diffusion, not yet timed on a GPU: 1500 s), the checkpoints evaluated at low CPU priority as
+#   they appear, and those left after training ends side by side.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset (ACTIONS=hand_relative:
-#   `act_hand_relative_<CONDITION>_compact`); decodes with torchcodec when FFmpeg's libraries can be found (PyAV's
+#   `<POLICY>_hand_relative_<CONDITION>_compact`); decodes with torchcodec when FFmpeg's libraries can be found (PyAV's
 #   bundled copy, tools/pyav_ffmpeg.sh), else with PyAV. A run whose logged loss becomes NaN (float16 AMP
 #   overflowing: three ACT trainings in docs/results; the hand-frame preset runs its network in bfloat16 under AMP
 #   for that reason) is stopped there and fails (exit 3) instead of spending the slot on NaN checkpoints.
@@ -68,6 +71,7 @@ EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
 SEED=${SEED:-1000}
 CHECKPOINTS=${CHECKPOINTS:-all}
 ACTIONS=${ACTIONS:-absolute}
+POLICY=${POLICY:-act}
 if [ "$ACTIONS" = hand_relative ]; then STATE_INPUT=${STATE_INPUT:-off}; else STATE_INPUT=${STATE_INPUT:-on}; fi
 STATE_NOISE=${STATE_NOISE:-}
 GPUS=${GPUS:-1}
@@ -97,6 +101,15 @@ case "$ACTIONS" in
       exit 2
     fi ;;
   *) echo "ACTIONS must be absolute or hand_relative, got '$ACTIONS'" >&2; exit 2 ;;
+esac
+case "$POLICY" in
+  act) ;;
+  diffusion) if [ "$ACTIONS" != hand_relative ]; then
+      echo "POLICY=diffusion takes ACTIONS=hand_relative alone (its preset is" \
+        "diffusion_hand_relative_<CONDITION>_compact), got ACTIONS=$ACTIONS" >&2
+      exit 2
+    fi ;;
+  *) echo "POLICY must be act or diffusion, got '$POLICY'" >&2; exit 2 ;;
 esac
 if [ -n "$STATE_NOISE" ] && ! [[ "$STATE_NOISE" =~ ^[0-9]+(\.[0-9]+)?,[0-9]+(\.[0-9]+)?$ ]]; then
   echo "STATE_NOISE must be empty (off) or POSITION_M,ROTATION_DEG, two decimal numbers >= 0 such as 0.02,5;" \
@@ -143,10 +156,10 @@ while chunk := os.read(0, 1 << 16):
         sys.exit(3)
     seen = chunk'
 
-preset() {  # prints the path of the condition's compact preset (ACTIONS=hand_relative: the hand-frame one); with
-  # STATE_INPUT=off and absolute actions, of a copy without the state input
+preset() {  # prints the path of the condition's compact preset (ACTIONS=hand_relative: POLICY's hand-frame one);
+  # with STATE_INPUT=off and absolute actions, of a copy without the state input
   local shipped copy="$WORK/preset_act_${CONDITION}_compact_no_state.json"
-  if [ "$ACTIONS" = hand_relative ]; then tavis presets "act_hand_relative_${CONDITION}_compact"; return; fi
+  if [ "$ACTIONS" = hand_relative ]; then tavis presets "${POLICY}_hand_relative_${CONDITION}_compact"; return; fi
   shipped=$(tavis presets "act_${CONDITION}_compact")
   if [ "$STATE_INPUT" = on ]; then echo "$shipped"; return; fi
   mkdir -p "$WORK"
@@ -240,7 +253,8 @@ case "${1:-}" in
     ( if [ "$ACTIONS" = absolute ]; then  # the hand-frame preset holds its own budget
         export BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1600} STEPS=${STEPS:-4800}
       fi
-      WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "${TRAIN_S:-960}" "$0" train || true
+      if [ "$POLICY" = diffusion ]; then train_s=${TRAIN_S:-1500}; else train_s=${TRAIN_S:-960}; fi
+      WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "$train_s" "$0" train || true
       touch "$stopped" ) &
     ( while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
         nice -n 15 "$0" eval

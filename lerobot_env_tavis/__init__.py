@@ -1,8 +1,8 @@
 """The plugin module LeRobot imports in every CLI: registers `--env.type=tavis` (it loads LeRobot itself), and
-`--policy.type=act_hand_relative` where LeRobot's policies are loaded already, as lerobot-train and lerobot-eval load
-them before their plugins; the robot and teleop CLIs stay without them. Elsewhere
-`lerobot_tavis.policies.register_policy_types()` registers the policy type. In these CLIs a bad `--env.*` value is one
-line instead of a traceback, and so is LeRobot's warning that torchcodec cannot load (no system FFmpeg). With
+`--policy.type=act_hand_relative` and `diffusion_hand_relative` where LeRobot's policies are loaded already, as
+lerobot-train and lerobot-eval load them before their plugins; the robot and teleop CLIs stay without them. Elsewhere
+`lerobot_tavis.policies.register_policy_types()` registers the policy types. In these CLIs a bad `--env.*` value is
+one line instead of a traceback, and so is LeRobot's warning that torchcodec cannot load (no system FFmpeg). With
 `TAVIS_FRAME_CACHE=1`, lerobot-train (which has loaded LeRobot's dataset factory by then) reads video frames from the
 frame cache (`lerobot_tavis.dataset_tools.cached_dataset`)."""
 

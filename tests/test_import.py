@@ -27,11 +27,13 @@ def test_plugin_import_registers_the_env_type_and_loads_nothing_heavy():
     assert not [m for m in added if m.startswith(HEAVY)]
 
 
-def test_where_lerobot_policies_are_loaded_the_plugin_registers_the_policy_type_too():
+def test_where_lerobot_policies_are_loaded_the_plugin_registers_the_policy_types_too():
     loaded = _modules_after("import lerobot.policies, lerobot_env_tavis; from lerobot.configs.policies import "
                             "PreTrainedConfig; assert PreTrainedConfig.get_choice_class('act_hand_relative')"
-                            ".__name__ == 'ACTHandRelativeConfig'")
+                            ".__name__ == 'ACTHandRelativeConfig'; assert PreTrainedConfig.get_choice_class("
+                            "'diffusion_hand_relative').__name__ == 'DiffusionHandRelativeConfig'")
     assert "lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative" in loaded
+    assert "lerobot_tavis.policies.diffusion_hand_relative.configuration_diffusion_hand_relative" in loaded
 
 
 def test_where_lerobots_dataset_factory_is_loaded_the_switch_points_it_at_the_frame_cache():

@@ -142,11 +142,23 @@ def test_hand_relative_actions_train_the_hand_frame_preset_on_its_own_budget(tmp
     assert re.search(r"--steps=4800 --save_freq=1600 --batch_size=128( |$)", train.split(" | ")[0])
 
 
+def test_policy_diffusion_trains_the_hand_frame_diffusion_preset_on_its_budget(tmp_path):
+    shipped = preset_path("diffusion_hand_relative_fixed_wrist_compact")
+    calls = _run(tmp_path, "cell", POLICY="diffusion", ACTIONS="hand_relative", CONDITION="fixed_wrist",
+                 PRESET_FILE=str(shipped))
+    assert "tavis presets diffusion_hand_relative_fixed_wrist_compact | gpu= egl=" in calls
+    (train,) = [call for call in calls if call.startswith("lerobot-train")]
+    assert f"--config_path={shipped} " in train and not re.search(r"--(steps|save_freq|batch_size)=", train)
+
+
 @pytest.mark.parametrize(("settings", "message"), [
     (dict(ACTIONS="hand_relative", STATE_INPUT="on"), "ACTIONS=hand_relative takes STATE_INPUT=off alone"),
     (dict(ACTIONS="relative", STATE_INPUT="off"), "ACTIONS must be absolute or hand_relative, got 'relative'"),
+    (dict(POLICY="diffusion"), "POLICY=diffusion takes ACTIONS=hand_relative alone (its preset is "
+                               "diffusion_hand_relative_<CONDITION>_compact), got ACTIONS=absolute"),
+    (dict(POLICY="pi0", ACTIONS="hand_relative"), "POLICY must be act or diffusion, got 'pi0'"),
 ])
-def test_hand_relative_actions_with_the_state_input_or_unknown_actions_are_refused(tmp_path, settings, message):
+def test_hand_relative_actions_with_the_state_input_or_unknown_actions_or_policies_are_refused(tmp_path, settings, message):
     refused = _stubbed(tmp_path, "train", **settings)
     assert refused.returncode == 2 and message in refused.stderr
     assert not (tmp_path / "calls.log").exists()
