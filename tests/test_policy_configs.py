@@ -61,7 +61,7 @@ def test_every_preset_parses_and_matches_the_dataset_and_the_env(name, dataset_r
     from lerobot.utils.feature_utils import dataset_to_policy_features
 
     cfg = _parse(name, "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}")
-    policy, mode, compact = presets()[name]
+    policy, mode, _ = presets()[name]
     assert cfg.policy.type == policy and cfg.env.type == "tavis" and cfg.env.camera_mode == mode
     batch = {"act": 64, "act_hand_relative": 128, "diffusion_hand_relative": 128}.get(policy, 16)
     assert (cfg.policy.n_action_steps, cfg.batch_size) == ((10 if policy.startswith("act") else 8), batch)

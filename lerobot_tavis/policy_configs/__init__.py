@@ -1,4 +1,5 @@
-"""Training presets for `lerobot-train --config_path=<preset>`: pi0 and Diffusion Policy x camera modes.
+"""Training presets for `lerobot-train --config_path=<preset>`: pi0 and Diffusion Policy x camera modes, and compact
+presets for the paper's two camera conditions.
 
 Each preset is a partial LeRobot `TrainPipelineConfig` (JSON, shipped with the package) following the reference's
 hyper-parameters (docs/reference.md §10) in LeRobot 0.6 fields: an action chunk of 16 of which 8 are executed at 20 Hz,
@@ -26,6 +27,11 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
   (`time_input`: without it a fixed + wrists policy never starts its reach); batch 128, 3200 steps, a checkpoint
   every 800: the recipe of the trained baselines (docs/results/README.md); `--policy.time_input=false` suits a head +
   wrists policy alone better.
+
+- Hand-frame Diffusion Policy compact presets (`diffusion_hand_relative_head_wrist_compact`,
+  `diffusion_hand_relative_fixed_wrist_compact`): `diffusion_hand_relative` (lerobot_tavis.policies) on the hand-frame
+  ACT presets' cameras, time input, optimiser, schedule and budget; 2 observation steps, a horizon of 16 of which 8
+  are executed, UNet 256-512-1024, 10 DDIM steps when acting, `observation.state` read as the anchor alone.
 
 `tavis train` checks a local dataset against the preset first (`check_training_dataset`): the cameras the policy
 reads must be there and, for ACT (which does not resize its images), at the preset's size.
