@@ -297,6 +297,14 @@ def build_parser() -> argparse.ArgumentParser:
          _printing("lerobot_tavis.eval.baselines:run_table_add"),
          "add (or replace) one cell of the baselines table in docs/results/baselines.json, checked against its "
          "results.json"),
+        ("table", "lerobot_tavis.eval.baselines_table:TableConfig",
+         _printing("lerobot_tavis.eval.baselines_table:run_table"),
+         "the baselines table from docs/results/baselines.json: per robot, tasks x conditions and splits with Wilson "
+         "CIs, GALT, pooled rows, the paper's numbers and targets (Markdown), and its plot"),
+        ("ablation", "lerobot_tavis.eval.baselines_table:AblationConfig",
+         _printing("lerobot_tavis.eval.baselines_table:run_ablation"),
+         "the wrist-only ablation (clutter_pick_cube with and without the head camera's active vision against "
+         "blocked_clutter_pick_cube) from the baselines table: Wilson CIs and exact McNemar"),
     ):
         commands.add_parser(name, help=help, options=options).set_defaults(run=run)
     return parser
