@@ -151,6 +151,7 @@ def table_plot(entries: list[Entry], root: Path, path: Path) -> Path:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
 
     from lerobot_tavis.eval.report import save_figure
 
@@ -176,12 +177,13 @@ def table_plot(entries: list[Entry], root: Path, path: Path) -> Path:
             if not any((robot, task, condition, "id") in cells for condition in CONDITIONS):
                 ax.text(x, 2, "not run", ha="center", fontsize=8, color="grey")
         paper = PAPER_HANDS_ID.get(robot, {})
-        ax.scatter([tasks.index(task) - width / 2 for task in paper], [100 * value for value in paper.values()],
-                   marker="D", color="black", zorder=3, label="paper (head, id)")
+        markers = ax.scatter([tasks.index(task) - width / 2 for task in paper], [100 * v for v in paper.values()],
+                             marker="D", color="black", zorder=3, label="paper (head, id)")
         ax.set_title(robot)
         ax.set_ylabel("success (%), Wilson 95%")
         ax.set_ylim(0, 105)
-        ax.legend(loc="upper left", fontsize=8)
+        ax.legend(handles=[*(Patch(color=CONDITION_COLOURS[c], label=f"{CONDITION_TITLES[c]}, id") for c in CONDITIONS),
+                           markers], loc="upper left", fontsize=8)  # a robot without bars still names both
     axes[-1].set_xticks(range(len(tasks)), tasks, rotation=30, ha="right")
     fig.tight_layout()
     written = save_figure(fig, path)
