@@ -19,7 +19,8 @@
 #
 # Settings: ROOT (the repository root, where RESULTS and BASELINES lie: this script's), RESULTS
 # (docs/results/baselines), BASELINES (docs/results/baselines.json), WORK (/tmp/tavis_table), HUB_OWNER (the Hub
-# account the model cards name: tavis), ROBOTS and TASKS (the cells `table` runs: every robot and task, in catalog
+# account the model cards name: tavis), COMMIT (what recipe.json records as the code's commit: `git describe` of ROOT;
+# set it where the checkout has no .git), ROBOTS and TASKS (the cells `table` runs: every robot and task, in catalog
 # order), TRAIN_S (1500: seconds after which a training is stopped, and its cell fails); for tiny runs that test the
 # pipeline, EPISODES, STEPS, BATCH, EVAL_EPISODES and DEVICE (cuda; cpu). WORKERS, EVAL_JOBS, EVAL_BATCH and FILM
 # pass on to train_baseline.sh.
@@ -59,7 +60,8 @@ elif sys.argv[1] == "write":
     gpus = output("nvidia-smi", "--query-gpu=name", "--format=csv,noheader").splitlines()
     machine = f"{len(gpus)} x {gpus[0]}, " if gpus else ""
     record = {"recipe": recipe, "command": sys.argv[3],
-              "commit": output("git", "describe", "--always", "--dirty", "--abbrev=12") or "not a git checkout",
+              "commit": env.get("COMMIT") or output("git", "describe", "--always", "--dirty", "--abbrev=12")
+              or "not recorded: set COMMIT outside a git checkout",
               "machine": f"{machine}{os.cpu_count()} cores, {platform.node()}",
               "finished_utc": output("date", "-u", "+%Y-%m-%dT%H:%M:%SZ")}
     with open(sys.argv[2] + ".tmp", "w") as file:

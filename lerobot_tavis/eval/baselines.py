@@ -11,6 +11,7 @@ replaces one entry (`add_entry`: checked, under a lock, written whole); `tavis t
 from __future__ import annotations
 
 import json
+import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -18,11 +19,12 @@ from lerobot_tavis.atomic import write_text
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError
-from lerobot_tavis.locking import exclusive_output
+from lerobot_tavis.locking import OutputInUseError, exclusive_output
 from lerobot_tavis.readers import expect, read_json
 
 BASELINES_PATH = Path("docs/results/baselines.json")  # relative to the repository root
 CONDITIONS = ("head_wrist", "fixed_wrist")  # the paper's two conditions: its headcam and fixedcam
+LOCK_ATTEMPTS, LOCK_WAIT_S = 100, 0.1  # another writer holds the file for milliseconds: wait up to 10 s for it
 
 
 @dataclass(frozen=True)
@@ -126,11 +128,17 @@ def add_entry(path: str | Path, entry: Entry, root: str | Path = ".") -> Path:
     folder); the file is rewritten whole, in table order, one writer at a time."""
     path = Path(path)
     check_entry(entry, Path(root), "the new entry")
-    with exclusive_output(path):
-        entries = _parsed_entries(path) if path.exists() else []
-        kept = [old for old in entries if old.key != entry.key] + [entry]
-        kept.sort(key=lambda e: (e.robot, task_sort_key(e.task), CONDITIONS.index(e.camera_mode)))
-        return write_text(path, json.dumps([asdict(e) for e in kept], indent=2) + "\n")
+    for attempt in range(LOCK_ATTEMPTS):  # cells finishing together take turns
+        try:
+            with exclusive_output(path):
+                entries = _parsed_entries(path) if path.exists() else []
+                kept = [old for old in entries if old.key != entry.key] + [entry]
+                kept.sort(key=lambda e: (e.robot, task_sort_key(e.task), CONDITIONS.index(e.camera_mode)))
+                return write_text(path, json.dumps([asdict(e) for e in kept], indent=2) + "\n")
+        except OutputInUseError:
+            if attempt == LOCK_ATTEMPTS - 1:
+                raise
+            time.sleep(LOCK_WAIT_S)
 
 
 @dataclass(frozen=True, kw_only=True)

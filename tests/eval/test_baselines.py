@@ -119,3 +119,29 @@ def test_the_ablation_reads_its_three_cells_and_pairs_only_the_same_tasks_episod
         in text
     # The README's last-checkpoint comparison: 56 against 20 successes on the same 96 seeds.
     assert "96 paired episodes: A 56 successes, B 20; both 10, only A 46, only B 10; exact McNemar p < 0.001" in text
+
+
+def test_add_entry_waits_for_another_writer_of_the_file(tmp_path):
+    import threading
+    import time
+
+    from lerobot_tavis.locking import exclusive_output
+
+    results = _results(tmp_path, "cell", "gr1t2", "head_wrist", ("clutter_pick_cube", "id", 50, 96, 0.5))
+    baselines = tmp_path / "baselines.json"
+    held, release = threading.Event(), threading.Event()
+
+    def other_writer():
+        with exclusive_output(baselines):
+            held.set()
+            release.wait(5)
+
+    writer = threading.Thread(target=other_writer)
+    writer.start()
+    held.wait(5)
+    threading.Timer(0.3, release.set).start()
+    started = time.monotonic()
+    add_entry(baselines, _entry("gr1t2", "clutter_pick_cube", "head_wrist", results), tmp_path)
+    writer.join()
+    assert time.monotonic() - started >= 0.3  # it waited for the lock instead of failing
+    assert [e["results"] for e in json.loads(baselines.read_text())] == ["cell/results.json"]
