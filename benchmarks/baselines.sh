@@ -3,7 +3,8 @@
 #
 #   benchmarks/baselines.sh cell ROBOT TASK   both conditions (head_wrist, fixed_wrist) of one robot and task
 #   benchmarks/baselines.sh table             every robot and task not yet complete; one (robot, task) per pair of
-#                                             GPUs at once (4 GPUs: two), each condition on a GPU of its own
+#                                             GPUs at once (4 GPUs: two), each condition on a GPU of its own; then
+#                                             `tavis table` writes baselines.md and baselines.png beside BASELINES
 #
 # One recipe for every cell: the `act_hand_relative_<condition>_compact` presets, EPISODES (160) demonstrations,
 # STEPS (3200) steps of BATCH (128), training seed SEED (1000), the last checkpoint evaluated on EVAL_EPISODES (96)
@@ -22,8 +23,8 @@
 # account the model cards name: tavis), COMMIT (what recipe.json records as the code's commit: `git describe` of ROOT;
 # set it where the checkout has no .git), ROBOTS and TASKS (the cells `table` runs: every robot and task, in catalog
 # order), TRAIN_S (1500: seconds after which a training is stopped, and its cell fails); for tiny runs that test the
-# pipeline, EPISODES, STEPS, BATCH, EVAL_EPISODES and DEVICE (cuda; cpu). WORKERS, EVAL_JOBS, EVAL_BATCH and FILM
-# pass on to train_baseline.sh.
+# pipeline, EPISODES, STEPS, BATCH, EVAL_EPISODES and DEVICE (cuda; cpu). WORKERS, EVAL_JOBS, EVAL_BATCH, FILM and
+# VIDEO_BACKEND pass on to train_baseline.sh; its other settings are the recipe's, whatever the environment holds.
 set -euo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=${ROOT:-$(dirname "$HERE")}
@@ -69,10 +70,15 @@ elif sys.argv[1] == "write":
         file.write("\n")
     os.replace(sys.argv[2] + ".tmp", sys.argv[2])
 else:
-    recorded = json.load(open(sys.argv[1])).get("recipe")
+    try:
+        recorded = json.load(open(sys.argv[1]))["recipe"]
+        recorded.items()
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        sys.exit(f"baselines: {sys.argv[1]} is missing or damaged: remove its folder to make the cell again")
     if recorded != recipe:
-        changed = sorted(key for key in {**recipe, **(recorded or {})} if (recorded or {}).get(key) != recipe.get(key))
-        sys.exit(f"baselines: {sys.argv[1]} was made with another recipe ({", ".join(changed)} differ): one table "
+        changed = sorted(key for key in {**recipe, **recorded} if recorded.get(key) != recipe.get(key))
+        changed = ", ".join(changed)
+        sys.exit(f"baselines: {sys.argv[1]} was made with another recipe ({changed} differ): one table "
                  "holds one recipe; remove that folder to make the cell again with these settings")'
 
 cell_dir() { echo "$RESULTS/$1/$2/$3"; }  # cell_dir ROBOT TASK CONDITION
@@ -161,7 +167,7 @@ case "${1:-}" in
   table)
     python3 -c "$RECIPE" > /dev/null
     ROBOTS=${ROBOTS:-gr1t2 reachy2}
-    TASKS=${TASKS:-$(python3 -c "from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS; print(*BENCHMARK_TASKS)")}
+    TASKS=${TASKS:-$(python3 -c "from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS as t; print(*t)")}
     cells=()
     for robot in $ROBOTS; do
       for task in $TASKS; do
@@ -182,13 +188,15 @@ case "${1:-}" in
         elif (( ${#gpus[@]} == 1 )); then export CUDA_VISIBLE_DEVICES=${gpus[0]}; fi
         for (( i = slot; i < ${#cells[@]}; i += slots )); do
           read -r robot task <<< "${cells[i]}"
-          WORKERS=$(( WORKERS / slots > 1 ? WORKERS / slots : 1 )) "$HERE/baselines.sh" cell "$robot" "$task" || status=1
+          WORKERS=$(( WORKERS / slots > 1 ? WORKERS / slots : 1 )) "$HERE/baselines.sh" cell "$robot" "$task" \
+            || status=1
         done
         exit "$status" ) &
       pids+=($!)
     done
     status=0
     for pid in "${pids[@]}"; do wait "$pid" || status=1; done
+    tavis table --baselines "$BASELINES" --out "$(dirname "$BASELINES")"  # the table as far as it goes
     exit "$status"
     ;;
   *)

@@ -30,7 +30,8 @@
 # and reads the frames from it, TAVIS_FRAME_CACHE=1; docs/training.md, "Training at scale"),
 # SPLITS (id: the splits each evaluation plays, comma-separated; table: id for fixed_wrist and id, ood_spatial and
 # ood_init_pose for head_wrist, the baselines table's protocol), DEVICE (cuda; cpu: training and evaluation without
-# a GPU and without AMP, for tiny runs that test the pipeline), WORK (/tmp/tavis_baseline).
+# a GPU and without AMP, for tiny runs that test the pipeline), VIDEO_BACKEND (how training decodes the dataset's
+# videos: torchcodec where it loads, else pyav), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
@@ -123,6 +124,11 @@ if [ "$SPLITS" = table ]; then
   if [ "$CONDITION" = head_wrist ]; then splits="id ood_spatial ood_init_pose"; else splits=id; fi
 fi
 read -ra splits <<< "$splits"
+case "${VIDEO_BACKEND:-}" in
+  ''|pyav|torchcodec) ;;
+  *) echo "VIDEO_BACKEND must be pyav or torchcodec (or unset: torchcodec where it loads), got '$VIDEO_BACKEND'" >&2
+    exit 2 ;;
+esac
 case "$DEVICE" in
   cuda) AMP=true ;;
   cpu) AMP=false ;;
@@ -131,9 +137,11 @@ esac
 SIZE=120x160
 HERE=$(cd "$(dirname "$0")" && pwd)
 
-choose_video_backend() {  # BACKEND=torchcodec when it loads (with PyAV's FFmpeg if the system has none), else pyav
+choose_video_backend() {  # BACKEND=VIDEO_BACKEND if set, else torchcodec when it loads (with PyAV's FFmpeg if the
+  # system has none), else pyav
   eval "$("$HERE/../tools/pyav_ffmpeg.sh" "$WORK/ffmpeg")"  # exports LD_LIBRARY_PATH for lerobot-train
-  BACKEND=$(python3 -c "from lerobot_tavis.dataset_tools.quiet import video_backend; print(video_backend())")
+  BACKEND=${VIDEO_BACKEND:-$(python3 -c "from lerobot_tavis.dataset_tools.quiet import video_backend
+print(video_backend())")}
 }
 
 record() {  # the demonstrations, once: every condition of TASK converts the same ones

@@ -14,13 +14,16 @@ REPO = SCRIPT.parents[1]
 
 LOG_CALL = 'echo "$(basename "$0") $* | gpu=${CUDA_VISIBLE_DEVICES:-} egl=${MUJOCO_EGL_DEVICE_ID:-}" >> "$CALLS"\n'
 # tavis: the GPU work stood in for; every other subcommand is the real one.
-TAVIS = LOG_CALL + """value() { local previous; for arg in "$@"; do [ "${previous:-}" = "$FLAG" ] && echo "$arg"; previous=$arg; done; }
+TAVIS = LOG_CALL + """value() {  # the argument after $FLAG
+  local previous; for arg in "$@"; do [ "${previous:-}" = "$FLAG" ] && echo "$arg"; previous=$arg; done; }
 case $1 in
   record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
   presets) echo /dev/null ;;
   convert|curve) ;;
   eval) out=${@: -1}; mkdir -p "$out/tavis_head__id/videos"
-    printf '{"cells": [{"task": "%s", "split": "id"}], "sources": [{"robots": ["%s"], "camera_modes": ["%s"]}]}' \\
+    format='{"cells": [{"task": "%s", "split": "id", "successes": 1, "n": 2}], '
+    format+='"sources": [{"robots": ["%s"], "camera_modes": ["%s"]}]}'
+    printf "$format" \\
       "$(FLAG=--tasks value "$@")" "$(FLAG=--robot value "$@")" "$(FLAG=--camera-mode value "$@")" \\
       > "$out/results.json" ;;
   push-policy) out=$(FLAG=--out value "$@"); mkdir -p "$out"; echo "card of $(FLAG=--repo-id value "$@")" \\
@@ -29,8 +32,9 @@ case $1 in
 esac
 """
 # lerobot-train: one checkpoint, at the last step, as train_baseline.sh's SAVE_FREQ=STEPS asks; none with NO_CHECKPOINT.
-LEROBOT_TRAIN = LOG_CALL + """for arg in "$@"; do case $arg in --output_dir=*) out=${arg#*=} ;; --steps=*) steps=${arg#*=} ;;
-  esac; done
+LEROBOT_TRAIN = LOG_CALL + """for arg in "$@"; do
+  case $arg in --output_dir=*) out=${arg#*=} ;; --steps=*) steps=${arg#*=} ;; esac
+done
 [ -n "${NO_CHECKPOINT:-}" ] && exit 1
 step=$(printf %06d "$steps"); mkdir -p "$out/checkpoints/$step/pretrained_model"
 echo '{}' > "$out/checkpoints/$step/pretrained_model/train_config.json"; ln -sfn "$step" "$out/checkpoints/last"
@@ -47,8 +51,8 @@ def _baselines(tmp_path, *args, **settings) -> subprocess.CompletedProcess:
     env = {**os.environ, "PATH": f"{stubs}:{Path(sys.executable).parent}:{os.environ['PATH']}",
            "PYTHONPATH": str(REPO), "PYTHON": sys.executable, "CALLS": str(tmp_path / "calls.log"),
            "ROOT": str(tmp_path), "RESULTS": "results", "BASELINES": "baselines.json", "WORK": str(tmp_path / "work"),
-           "WORKERS": "4", "STEPS": "20", "CUDA_VISIBLE_DEVICES": "0,1", "TRAIN_OPTIONS": "--steps=1", **settings}
-    return subprocess.run(["bash", str(SCRIPT), *args], env=env, capture_output=True, text=True, timeout=120)
+           "WORKERS": "4", "STEPS": "20", "CUDA_VISIBLE_DEVICES": "0,1", "TRAIN_OPTIONS": "--steps=1", "VIDEO_BACKEND": "pyav", **settings}
+    return subprocess.run(["bash", str(SCRIPT), *args], env=env, capture_output=True, text=True, timeout=600)
 
 
 def _calls(tmp_path, tool: str) -> list[str]:
@@ -79,9 +83,11 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
                                                                    "results.json", "tavis_head__id",
                                                                    "train_config.json"]
         assert not (folder / "tavis_head__id" / "videos").exists()  # the videos stay in WORK
-        assert (folder / "model_card.md").read_text() == f"card of tavis/act_hand_relative_gr1t2_clutter_pick_cube_{mode}\n"
+        card = (folder / "model_card.md").read_text()
+        assert card == f"card of tavis/act_hand_relative_gr1t2_clutter_pick_cube_{mode}\n"
         recorded = json.loads((folder / "recipe.json").read_text())
-        assert recorded["recipe"]["steps"] == 20 and recorded["command"] == "benchmarks/baselines.sh cell gr1t2 clutter_pick_cube"
+        assert recorded["recipe"]["steps"] == 20
+        assert recorded["command"] == "benchmarks/baselines.sh cell gr1t2 clutter_pick_cube"
     assert not list((tmp_path / "results" / "gr1t2" / "clutter_pick_cube").glob(".*"))
 
     (tmp_path / "calls.log").unlink()
@@ -110,13 +116,20 @@ def test_the_table_runs_two_cells_at_once_on_four_gpus_and_leaves_a_failed_train
     assert "2 (robot, task) cells to run, 2 at once, on GPUs: 0 1 2 3" in run.stdout
     trains = sorted((call.split("--env.task=")[1].split()[0], call.split("/train_")[1].split()[0],
                      call.split(" | ")[1]) for call in _calls(tmp_path, "lerobot-train"))
-    assert trains == [("clutter_pick_cube", "fixed_wrist", "gpu=3 egl=3"), ("clutter_pick_cube", "head_wrist", "gpu=2 egl=2"),
-                      ("conditional_pick", "fixed_wrist", "gpu=1 egl=1"), ("conditional_pick", "head_wrist", "gpu=0 egl=0")]
+    assert trains == [("clutter_pick_cube", "fixed_wrist", "gpu=3 egl=3"),
+                      ("clutter_pick_cube", "head_wrist", "gpu=2 egl=2"),
+                      ("conditional_pick", "fixed_wrist", "gpu=1 egl=1"),
+                      ("conditional_pick", "head_wrist", "gpu=0 egl=0")]
     assert len(json.loads((tmp_path / "baselines.json").read_text())) == 4
+    table = (tmp_path / "baselines.md").read_text()  # rendered at the end
+    assert ("| TAVIS-Head | clutter_pick_cube | 50.0% [9.5, 90.5] | 50.0% [9.5, 90.5] | not run | not run | - | - |"
+            in table)
+    assert (tmp_path / "baselines.png").is_file()
 
     failed = _baselines(tmp_path / "failed", "cell", "reachy2", "peeking_box", NO_CHECKPOINT="1")
     assert failed.returncode == 1
-    assert "baselines: reachy2 peeking_box head_wrist failed: no evaluation of the checkpoint of step 20" in failed.stderr
+    assert ("baselines: reachy2 peeking_box head_wrist failed: no evaluation of the checkpoint of step 20"
+            in failed.stderr)
     assert not (tmp_path / "failed" / "results").exists() and not (tmp_path / "failed" / "baselines.json").exists()
 
 
