@@ -108,7 +108,8 @@ publish() {  # publish ROBOT TASK CONDITION: the evaluation of the last checkpoi
   rm -rf "$stage"
   mkdir -p "$(dirname "$stage")"
   cp -r "$evaluation" "$stage"
-  find "$stage" -depth -type d -name 'videos*' -exec rm -rf {} +  # the videos stay in WORK
+  # the videos stay in WORK; dot-named leftovers (locks, staging copies) are no results
+  find "$stage" -mindepth 1 -depth \( -type d -name 'videos*' -o -name '.*' \) -exec rm -rf {} +
   cp "$checkpoint/pretrained_model/train_config.json" "$stage/train_config.json"
   cp "$work/cell_$3.log" "$stage/log.txt"
   tavis push-policy "$checkpoint/pretrained_model" --repo-id "$HUB_OWNER/act_hand_relative_$1_$2_$3" \

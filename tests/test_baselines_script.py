@@ -20,7 +20,7 @@ case $1 in
   record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
   presets) echo /dev/null ;;
   convert|curve) ;;
-  eval) out=${@: -1}; mkdir -p "$out/tavis_head__id/videos"
+  eval) out=${@: -1}; mkdir -p "$out/tavis_head__id/videos" "$out/.tavis_head__id.chunks"
     format='{"cells": [{"task": "%s", "split": "id", "successes": 1, "n": 2}], '
     format+='"sources": [{"robots": ["%s"], "camera_modes": ["%s"]}]}'
     printf "$format" \\
@@ -82,7 +82,7 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
         assert sorted(path.name for path in folder.iterdir()) == ["log.txt", "model_card.md", "recipe.json",
                                                                    "results.json", "tavis_head__id",
                                                                    "train_config.json"]
-        assert not (folder / "tavis_head__id" / "videos").exists()  # the videos stay in WORK
+        assert not (folder / "tavis_head__id" / "videos").exists()  # the videos stay in WORK, no leftover
         card = (folder / "model_card.md").read_text()
         assert card == f"card of tavis/act_hand_relative_gr1t2_clutter_pick_cube_{mode}\n"
         recorded = json.loads((folder / "recipe.json").read_text())
