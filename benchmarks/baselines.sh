@@ -14,7 +14,8 @@
 # training config (train_config.json), the run's log (log.txt), the model card (model_card.md) and recipe.json (the
 # recipe, the commit, the machine, the command). That folder is moved into place whole, then its entry is added to
 # BASELINES (`tavis table-add`). A condition whose folder exists is skipped; one whose folder records another recipe
-# stops the command with a message naming it: one table, one recipe. WORK/<robot>_<task>/ keeps the recording,
+# stops the command with a message naming it: one table, one recipe. On the machine of an interrupted run, a
+# training that reached its last step is evaluated again (`tavis eval` resuming its finished chunks), not retrained. WORK/<robot>_<task>/ keeps the recording,
 # datasets, checkpoints, logs and the upload-ready model folders (model_<condition>/: checkpoint, card, results;
 # `huggingface-cli upload <repo id> <folder>`).
 #
@@ -121,28 +122,49 @@ publish() {  # publish ROBOT TASK CONDITION: the evaluation of the last checkpoi
   echo "baselines: $1 $2 $3 done: $final"
 }
 
+trained() {  # trained ROBOT TASK CONDITION: WORK holds the checkpoint of its training's last step
+  local last
+  last=$(readlink -e "$WORK/$1_$2/train_$3/checkpoints/last") || return 1
+  (( 10#$(basename "$last") == STEPS )) && [ -f "$last/pretrained_model/model.safetensors" ]
+}
+
 cell() {  # cell ROBOT TASK
-  local robot=$1 task=$2 work="$WORK/$1_$2" condition status=0 todo=()
+  local robot=$1 task=$2 work="$WORK/$1_$2" condition status=0 todo=() train=() gpus=() index=0
   for condition in "${CONDITIONS[@]}"; do
     if complete "$robot" "$task" "$condition"; then add_entry "$robot" "$task" "$condition"
     else todo+=("$condition"); fi
   done
   if (( ${#todo[@]} == 0 )); then echo "baselines: $robot $task complete, skipped"; return 0; fi
-  # The scratch folder of another recipe is removed; that of a killed run keeps its recording alone.
+  # The scratch folder of another recipe is removed. In that of an interrupted run, a finished training is kept
+  # and evaluated (`tavis eval` resumes its chunks); one cut short is trained again.
   if ! python3 -c "$RECIPE" "$work/recipe.json" 2> /dev/null; then rm -rf "$work"; fi
   mkdir -p "$work"
   python3 -c "$RECIPE" write "$work/recipe.json" "benchmarks/baselines.sh cell $robot $task"
-  for condition in "${todo[@]}"; do rm -rf "$work/train_$condition" "$work/eval_$condition"; done
-  echo "baselines: $robot $task: training ${todo[*]} (logs: $work/cell_<condition>.log)"
+  for condition in "${todo[@]}"; do
+    rm -rf "$work/eval_$condition"/*.running  # the mark of an evaluation under way, left by a killed one
+    if ! trained "$robot" "$task" "$condition"; then
+      rm -rf "$work/train_$condition" "$work/eval_$condition"
+      train+=("$condition")
+    fi
+  done
+  echo "baselines: $robot $task: ${todo[*]}; training ${train[*]:-none} (logs: $work/cell_<condition>.log)"
   ( export ROBOT=$robot TASK=$task WORK=$work WORKERS ACTIONS=hand_relative SAVE_FREQ=$STEPS CHECKPOINTS=last \
       SPLITS=table
-    if (( ${#todo[@]} == 2 )); then
-      "$HERE/train_baseline.sh" pair
-    else
-      if [ -n "${CUDA_VISIBLE_DEVICES:-}" ]; then  # the slot's first GPU
-        export CUDA_VISIBLE_DEVICES=${CUDA_VISIBLE_DEVICES%%,*} MUJOCO_EGL_DEVICE_ID=${CUDA_VISIBLE_DEVICES%%,*}
-      fi
-      CONDITION=${todo[0]} "$HERE/train_baseline.sh" cell > "$work/cell_${todo[0]}.log" 2>&1
+    if (( ${#train[@]} == 2 )); then
+      "$HERE/train_baseline.sh" pair  # one recording for both, each on a GPU of its own
+    else  # each condition on a GPU of its own: trained and evaluated (`cell`), or evaluated (`eval`)
+      [ -z "${CUDA_VISIBLE_DEVICES:-}" ] || IFS=, read -ra gpus <<< "$CUDA_VISIBLE_DEVICES"
+      WORKERS=$(( WORKERS / ${#todo[@]} > 1 ? WORKERS / ${#todo[@]} : 1 ))
+      for condition in "${todo[@]}"; do
+        ( if (( ${#gpus[@]} > 1 )); then
+            export CUDA_VISIBLE_DEVICES=${gpus[index]} MUJOCO_EGL_DEVICE_ID=${gpus[index]}
+          fi
+          mode=eval
+          if [[ " ${train[*]:-} " == *" $condition "* ]]; then mode=cell; : > "$work/cell_$condition.log"; fi
+          CONDITION=$condition "$HERE/train_baseline.sh" "$mode" >> "$work/cell_$condition.log" 2>&1 ) &
+        index=$(( index + 1 ))
+      done
+      wait
     fi ) || true  # each condition's outcome is read from its folders below
   for condition in "${todo[@]}"; do publish "$robot" "$task" "$condition" || status=1; done
   return "$status"

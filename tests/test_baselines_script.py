@@ -38,6 +38,7 @@ done
 [ -n "${NO_CHECKPOINT:-}" ] && exit 1
 step=$(printf %06d "$steps"); mkdir -p "$out/checkpoints/$step/pretrained_model"
 echo '{}' > "$out/checkpoints/$step/pretrained_model/train_config.json"; ln -sfn "$step" "$out/checkpoints/last"
+echo weights > "$out/checkpoints/$step/pretrained_model/model.safetensors"
 """
 
 
@@ -100,13 +101,25 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
     assert "was made with another recipe (training_seed differ)" in other.stderr
     assert not _calls(tmp_path, "lerobot-train")
 
-    lost = tmp_path / "results" / "gr1t2" / "clutter_pick_cube" / "fixed_wrist"  # as if the machine went mid-cell
-    subprocess.run(["rm", "-r", str(lost)], check=True)
+    lost = tmp_path / "results" / "gr1t2" / "clutter_pick_cube" / "fixed_wrist"  # the machine went mid-cell: the
+    subprocess.run(["rm", "-r", str(lost), str(tmp_path / "work")], check=True)  # results kept are those committed
     resumed = _baselines(tmp_path, "cell", "gr1t2", "clutter_pick_cube", CUDA_VISIBLE_DEVICES="2,3")
     assert resumed.returncode == 0, resumed.stderr
     (train,) = _calls(tmp_path, "lerobot-train")  # that condition alone, on the slot's first GPU
     assert "/train_fixed_wrist " in train and train.endswith("| gpu=2 egl=2")
     assert (lost / "results.json").is_file() and json.loads((tmp_path / "baselines.json").read_text()) == entries
+
+    # An evaluation killed after its training finished: evaluated again, not trained again.
+    work = tmp_path / "work" / "gr1t2_clutter_pick_cube" / "eval_fixed_wrist"
+    subprocess.run(["rm", "-r", str(lost), str(work / "step_20")], check=True)
+    (work / "step_20.running").mkdir()  # the mark the killed evaluation left
+    (tmp_path / "calls.log").unlink()
+    resumed = _baselines(tmp_path, "cell", "gr1t2", "clutter_pick_cube")
+    assert resumed.returncode == 0, resumed.stderr
+    assert not _calls(tmp_path, "lerobot-train") and not _calls(tmp_path, "tavis record")
+    (evaluation,) = _calls(tmp_path, "tavis eval")
+    assert "--camera-mode fixed_wrist " in evaluation and "--splits id --episodes 96 " in evaluation
+    assert json.loads((tmp_path / "baselines.json").read_text()) == entries
 
 
 def test_the_table_runs_two_cells_at_once_on_four_gpus_and_leaves_a_failed_training_out(tmp_path):
