@@ -15,9 +15,9 @@
 # recipe, the commit, the machine, the command). That folder is moved into place whole, then its entry is added to
 # BASELINES (`tavis table-add`). A condition whose folder exists is skipped; one whose folder records another recipe
 # stops the command with a message naming it: one table, one recipe. On the machine of an interrupted run, a
-# training that reached its last step is evaluated again (`tavis eval` resuming its finished chunks), not retrained. WORK/<robot>_<task>/ keeps the recording,
-# datasets, checkpoints, logs and the upload-ready model folders (model_<condition>/: checkpoint, card, results;
-# `huggingface-cli upload <repo id> <folder>`).
+# training that reached its last step is evaluated again (`tavis eval` resuming its finished chunks), not retrained.
+# WORK/<robot>_<task>/ keeps the recording, datasets, checkpoints, logs and the upload-ready model folders
+# (model_<condition>/: checkpoint, card, results; `huggingface-cli upload <repo id> <folder>`).
 #
 # Settings: ROOT (the repository root, where RESULTS and BASELINES lie: this script's), RESULTS
 # (docs/results/baselines), BASELINES (docs/results/baselines.json), WORK (/tmp/tavis_table), HUB_OWNER (the Hub

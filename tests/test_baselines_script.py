@@ -52,7 +52,8 @@ def _baselines(tmp_path, *args, **settings) -> subprocess.CompletedProcess:
     env = {**os.environ, "PATH": f"{stubs}:{Path(sys.executable).parent}:{os.environ['PATH']}",
            "PYTHONPATH": str(REPO), "PYTHON": sys.executable, "CALLS": str(tmp_path / "calls.log"),
            "ROOT": str(tmp_path), "RESULTS": "results", "BASELINES": "baselines.json", "WORK": str(tmp_path / "work"),
-           "WORKERS": "4", "STEPS": "20", "CUDA_VISIBLE_DEVICES": "0,1", "TRAIN_OPTIONS": "--steps=1", "VIDEO_BACKEND": "pyav", **settings}
+           "WORKERS": "4", "STEPS": "20", "CUDA_VISIBLE_DEVICES": "0,1", "TRAIN_OPTIONS": "--steps=1",
+           "VIDEO_BACKEND": "pyav", **settings}
     return subprocess.run(["bash", str(SCRIPT), *args], env=env, capture_output=True, text=True, timeout=600)
 
 
