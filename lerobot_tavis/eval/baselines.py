@@ -17,6 +17,7 @@ from pathlib import Path
 
 from lerobot_tavis.atomic import write_text
 from lerobot_tavis.cli_options import option
+from lerobot_tavis.envs.robots import robot_names
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.locking import OutputInUseError, exclusive_output
@@ -65,8 +66,6 @@ def check_entry(entry: Entry, root: Path, where: str) -> dict:
     """The entry's results.json, parsed, after checking the entry against it and the catalog: a known robot, task
     and condition, a relative path that exists under `root`, a results file played by that robot in that camera
     mode holding the task's id cell. InputError (PathNotFoundError for a missing file) naming `where`."""
-    from lerobot_tavis.envs.robots import robot_names
-
     for name, allowed in (("robot", robot_names()), ("task", BENCHMARK_TASKS), ("camera_mode", CONDITIONS)):
         if getattr(entry, name) not in allowed:
             raise InputError(f"{where}: {name} must be one of {', '.join(allowed)}, got {getattr(entry, name)!r}")
@@ -145,8 +144,8 @@ def add_entry(path: str | Path, entry: Entry, root: str | Path = ".") -> Path:
 class TableAddConfig:
     """`tavis table-add`: one entry of the table, added or replaced."""
 
-    robot: str = option(help="the robot the policy was trained and evaluated on")
-    task: str = option(help="the task of the single-task policy")
+    robot: str = option(help="the robot the policy was trained and evaluated on", choices=robot_names)
+    task: str = option(help="the task of the single-task policy", choices=BENCHMARK_TASKS)
     camera_mode: str = option(help="the paper's condition the policy was trained in", choices=CONDITIONS)
     policy: str = option(help="the recipe: the preset the policy was trained with")
     training_seed: int = option(help="lerobot-train's --seed")
