@@ -31,7 +31,10 @@
 # one per visible GPU, each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS
 # and SAVE_FREQ by N for the one-GPU budget), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
 # and reads the frames from it, TAVIS_FRAME_CACHE=1; docs/training.md, "Training at scale"),
-# WORK (/tmp/tavis_baseline).
+# SPLITS (id: the splits each evaluation plays, comma-separated; table: id for fixed_wrist and id, ood_spatial and
+# ood_init_pose for head_wrist, the baselines table's protocol), DEVICE (cuda; cpu: training and evaluation without
+# a GPU and without AMP, for tiny runs that test the pipeline), VIDEO_BACKEND (how training decodes the dataset's
+# videos: torchcodec where it loads, else pyav), WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
 #   GPU where two or more are visible (CUDA_VISIBLE_DEVICES, else all: a two-GPU slot gives both arms of the
@@ -76,6 +79,8 @@ if [ "$ACTIONS" = hand_relative ]; then STATE_INPUT=${STATE_INPUT:-off}; else ST
 STATE_NOISE=${STATE_NOISE:-}
 GPUS=${GPUS:-1}
 FRAME_CACHE=${FRAME_CACHE:-off}
+SPLITS=${SPLITS:-id}
+DEVICE=${DEVICE:-cuda}
 read -ra eval_options <<< "${EVAL_OPTIONS:-}"  # its words; EVAL_OPTIONS stays a string for the modes run again below
 read -ra train_options <<< "${TRAIN_OPTIONS:-}"
 WORK=${WORK:-/tmp/tavis_baseline}
@@ -127,12 +132,29 @@ case "$FRAME_CACHE" in
   on|off) ;;
   *) echo "FRAME_CACHE must be on or off, got '$FRAME_CACHE'" >&2; exit 2 ;;
 esac
+splits=${SPLITS//,/ }  # SPLITS itself is left as given: `pair` passes it on to both conditions
+if [ "$SPLITS" = table ]; then
+  if [ "$CONDITION" = head_wrist ]; then splits="id ood_spatial ood_init_pose"; else splits=id; fi
+fi
+read -ra splits <<< "$splits"
+case "${VIDEO_BACKEND:-}" in
+  ''|pyav|torchcodec) ;;
+  *) echo "VIDEO_BACKEND must be pyav or torchcodec (or unset: torchcodec where it loads), got '$VIDEO_BACKEND'" >&2
+    exit 2 ;;
+esac
+case "$DEVICE" in
+  cuda) AMP=true ;;
+  cpu) AMP=false ;;
+  *) echo "DEVICE must be cuda or cpu, got '$DEVICE'" >&2; exit 2 ;;
+esac
 SIZE=120x160
 HERE=$(cd "$(dirname "$0")" && pwd)
 
-choose_video_backend() {  # BACKEND=torchcodec when it loads (with PyAV's FFmpeg if the system has none), else pyav
+choose_video_backend() {  # BACKEND=VIDEO_BACKEND if set, else torchcodec when it loads (with PyAV's FFmpeg if the
+  # system has none), else pyav
   eval "$("$HERE/../tools/pyav_ffmpeg.sh" "$WORK/ffmpeg")"  # exports LD_LIBRARY_PATH for lerobot-train
-  BACKEND=$(python3 -c "from lerobot_tavis.dataset_tools.quiet import video_backend; print(video_backend())")
+  BACKEND=${VIDEO_BACKEND:-$(python3 -c "from lerobot_tavis.dataset_tools.quiet import video_backend
+print(video_backend())")}
 }
 
 record() {  # the demonstrations, once: every condition of TASK converts the same ones
@@ -206,7 +228,7 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]: fails wi
   fi
   "${launch[@]}" --config_path="$config" \
     --dataset.repo_id="local/$(basename "$dataset")" --dataset.root="$dataset" --dataset.video_backend="$BACKEND" \
-    --env.task="$TASK" --env.robot="$ROBOT" --policy.device=cuda --policy.use_amp=true \
+    --env.task="$TASK" --env.robot="$ROBOT" --policy.device="$DEVICE" --policy.use_amp="$AMP" \
     --num_workers=$(( WORKERS / GPUS > 1 ? WORKERS / GPUS : 1 )) \
     --seed="$SEED" --log_freq=100 --output_dir="$out" "${train_options[@]}" "$@" 2>&1 \
     | python3 -c "$PASS_UNTIL_NAN_LOSS" "--output_dir=$out( |$)" || status=$?
@@ -217,10 +239,10 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]: fails wi
   return "$status"
 }
 
-evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the id split of TASK
+evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the SPLITS of TASK
   local per_job=$(( ($4 + EVAL_JOBS - 1) / EVAL_JOBS ))
-  tavis eval --policy "$1/pretrained_model" --tasks "$TASK" --splits id --episodes "$4" --seed "$3" --robot "$ROBOT" \
-    --camera-mode "$CONDITION" --image-size "$SIZE" --device cuda --policy-option use_amp=true \
+  tavis eval --policy "$1/pretrained_model" --tasks "$TASK" --splits "${splits[@]}" --episodes "$4" --seed "$3" \
+    --robot "$ROBOT" --camera-mode "$CONDITION" --image-size "$SIZE" --device "$DEVICE" --policy-option "use_amp=$AMP" \
     --workers "$EVAL_JOBS" --chunk-episodes "$per_job" --batch-size $(( per_job < EVAL_BATCH ? per_job : EVAL_BATCH )) \
     --film-episodes "$FILM" "${eval_options[@]}" --out "$2"
 }
@@ -258,9 +280,9 @@ case "${1:-}" in
       touch "$stopped" ) &
     ( while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
         nice -n 15 "$0" eval
-        sleep 10
+        for _ in {1..10}; do [ -f "$stopped" ] || sleep 1; done  # a look every 10 s while training goes on
       done ) &
-    while [ ! -f "$stopped" ]; do sleep 5; done
+    while [ ! -f "$stopped" ]; do sleep 1; done
     "$0" eval  # the checkpoints left, side by side with the one still being evaluated
     wait
     ;;

@@ -52,6 +52,9 @@ class PushPolicyOptions:
                                         "rates written into the model card (default: none)")
     private: bool = option(False, "make the Hub repository private")
     branch: str | None = option(None, "push to this branch (default: main)")
+    out: Path | None = option(None, "write the folder that would be uploaded (checkpoint, model card, results) here "
+                                    "instead, without network or login, for a later `huggingface-cli upload` "
+                                    "(default: upload)")
 
 
 @dataclass(frozen=True)
@@ -172,7 +175,7 @@ def _push_policy(options: PushPolicyOptions) -> None:
     from lerobot_tavis.policies.hub import push_policy
 
     print(push_policy(options.checkpoint, options.repo_id, results=options.results, private=options.private,
-                      branch=options.branch))
+                      branch=options.branch, out=options.out))
 
 
 def _pull(options: PullOptions) -> None:
@@ -290,6 +293,18 @@ def build_parser() -> argparse.ArgumentParser:
          "success by training step from one eval output per checkpoint (step_<N>/): checkpoints.md and .png"),
         ("compare", CompareOptions, _printing("lerobot_tavis.eval.compare:run_compare"),
          "two evaluations of the same seeds, episode by episode: successes of each and the exact McNemar test"),
+        ("table-add", "lerobot_tavis.eval.baselines:TableAddConfig",
+         _printing("lerobot_tavis.eval.baselines:run_table_add"),
+         "add (or replace) one cell of the baselines table in docs/results/baselines.json, checked against its "
+         "results.json"),
+        ("table", "lerobot_tavis.eval.baselines_table:TableConfig",
+         _printing("lerobot_tavis.eval.baselines_table:run_table"),
+         "the baselines table from docs/results/baselines.json: per robot, tasks x conditions and splits with Wilson "
+         "CIs, GALT, pooled rows, the paper's numbers and targets (Markdown), and its plot"),
+        ("ablation", "lerobot_tavis.eval.baselines_table:AblationConfig",
+         _printing("lerobot_tavis.eval.baselines_table:run_ablation"),
+         "the wrist-only ablation (clutter_pick_cube with and without the head camera's active vision against "
+         "blocked_clutter_pick_cube) from the baselines table: Wilson CIs and exact McNemar"),
     ):
         commands.add_parser(name, help=help, options=options).set_defaults(run=run)
     return parser

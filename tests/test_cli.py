@@ -60,9 +60,10 @@ COMMAND_LINES = {
                          seed=3)),
     "push": (["dataset", "--repo-id", "me/tavis", "--private", "--branch", "v2"],
              dict(root=Path("dataset"), repo_id="me/tavis", private=True, branch="v2")),
-    "push-policy": (["ckpt", "--repo-id", "me/act", "--results", "results.json", "--private", "--branch", "v2"],
+    "push-policy": (["ckpt", "--repo-id", "me/act", "--results", "results.json", "--private", "--branch", "v2",
+                     "--out", "card"],
                     dict(checkpoint=Path("ckpt"), repo_id="me/act", results=Path("results.json"), private=True,
-                         branch="v2")),
+                         branch="v2", out=Path("card"))),
     "pull": (["me/tavis", "--root", "here", "--revision", "v2"],
              dict(repo_id="me/tavis", root=Path("here"), revision="v2")),
     "presets": (["diffusion_head_wrist"], dict(name="diffusion_head_wrist")),
@@ -71,6 +72,14 @@ COMMAND_LINES = {
     "report": (["evals"], dict(eval_dir=Path("evals"))),
     "curve": (["evals"], dict(eval_root=Path("evals"))),
     "compare": (["a", "b"], dict(eval_a=Path("a"), eval_b=Path("b"))),
+    "table-add": (["--robot", "gr1t2", "--task", "peeking_box", "--camera-mode", "fixed_wrist", "--policy", "p",
+                   "--training-seed", "7", "--results", "r/results.json", "--baselines", "b.json", "--root", "repo"],
+                  dict(robot="gr1t2", task="peeking_box", camera_mode="fixed_wrist", policy="p", training_seed=7,
+                       results=Path("r/results.json"), baselines=Path("b.json"), root=Path("repo"))),
+    "table": (["--baselines", "b.json", "--root", "repo", "--out", "docs"],
+              dict(baselines=Path("b.json"), root=Path("repo"), out_dir=Path("docs"))),
+    "ablation": (["--robot", "reachy2", "--baselines", "b.json", "--root", "repo", "--out", "ablation.md"],
+                 dict(robot="reachy2", baselines=Path("b.json"), root=Path("repo"), out=Path("ablation.md"))),
 }
 # The least each subcommand needs, and what the dataclass is then built with directly: the rest are its defaults.
 MINIMAL = {
@@ -94,6 +103,12 @@ MINIMAL = {
     "report": (["evals"], dict(eval_dir=Path("evals"))),
     "curve": (["evals"], dict(eval_root=Path("evals"))),
     "compare": (["a", "b"], dict(eval_a=Path("a"), eval_b=Path("b"))),
+    "table-add": (["--robot", "gr1t2", "--task", "peeking_box", "--camera-mode", "fixed_wrist", "--policy", "p",
+                   "--training-seed", "7", "--results", "r/results.json"],
+                  dict(robot="gr1t2", task="peeking_box", camera_mode="fixed_wrist", policy="p", training_seed=7,
+                       results=Path("r/results.json"))),
+    "table": ([], {}),
+    "ablation": (["--robot", "gr1t2"], dict(robot="gr1t2")),
 }
 OFF_THE_COMMAND_LINE = {"record": {"max_attempts_factor"}, "view": {"max_frames"}}
 

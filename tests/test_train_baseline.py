@@ -241,9 +241,20 @@ def test_gpus_train_data_parallel_through_accelerate_and_frame_cache_reads_a_cac
     ({"GPUS": "0"}, "GPUS must be a number of GPUs >= 1, got '0'"),
     ({"GPUS": "two"}, "GPUS must be a number of GPUs >= 1, got 'two'"),
     ({"FRAME_CACHE": "1"}, "FRAME_CACHE must be on or off, got '1'"),
+    ({"DEVICE": "gpu"}, "DEVICE must be cuda or cpu, got 'gpu'"),
     ({"GPUS": "2", "MODE": "pair"}, "pair gives each condition one GPU of its own; GPUS=2 applies to train, cell"),
 ])
 def test_bad_gpus_or_frame_cache_are_refused_before_anything_runs(tmp_path, settings, message):
     refused = _stubbed(tmp_path, settings.pop("MODE", "train"), **settings)
     assert refused.returncode == 2 and message in refused.stderr
     assert not (tmp_path / "calls.log").exists()
+
+
+def test_device_cpu_trains_and_evaluates_without_a_gpu_or_amp_and_splits_reach_tavis_eval(tmp_path):
+    (train,) = [call for call in _run(tmp_path, "train", DEVICE="cpu") if call.startswith("lerobot-train")]
+    assert " --policy.device=cpu --policy.use_amp=false " in train
+    calls = _run(tmp_path / "again", "eval", WORK=str(tmp_path / "work"), DEVICE="cpu", CHECKPOINTS="last",
+                 SPLITS="id,ood_spatial")
+    (evaluation,) = [call for call in calls if call.startswith("tavis eval")]
+    assert " --splits id ood_spatial --episodes 96 " in evaluation
+    assert " --device cpu --policy-option use_amp=false " in evaluation

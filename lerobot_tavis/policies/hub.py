@@ -98,16 +98,25 @@ def policy_card(checkpoint: str | Path, repo_id: str, results: dict | None = Non
 
 
 def push_policy(checkpoint: str | Path, repo_id: str, *, results: str | Path | None = None, private: bool = False,
-                branch: str | None = None) -> str:
+                branch: str | None = None, out: str | Path | None = None) -> str:
     """Upload the checkpoint folder `checkpoint` (a `pretrained_model`) to the Hub as the model `repo_id`, with our
-    card and, when given, the `results` file (a `tavis report` results.json); returns the model's URL.
+    card and, when given, the `results` file (a `tavis report` results.json); returns the model's URL. With `out`,
+    write that folder to `out` instead (complete or not at all, replacing an older one) and return its path: no
+    network and no login, ready for `huggingface-cli upload <repo id> <out>`.
 
-    Checks `repo_id`, the folder, the results file and that a Hub token exists before uploading anything."""
+    Checks `repo_id`, the folder, the results file and (for an upload) that a Hub token exists before writing or
+    uploading anything."""
     checks.repo_id(repo_id)
     folder = pretrained_model_dir(checkpoint)
     if not (folder / WEIGHTS_NAME).is_file():
         raise PathNotFoundError(f"{folder} holds no {WEIGHTS_NAME}: pass a checkpoint's pretrained_model folder")
     report = _read_results(Path(results)) if results is not None else None
+    if out is not None:
+        from lerobot_tavis.dataset_tools.staging import staged_directory
+
+        with staged_directory(out, overwrite=True) as staged:
+            _stage(folder, policy_card(folder, repo_id, report), results, staged)
+        return str(out)
     from huggingface_hub import HfApi, constants, get_token
 
     if get_token() is None:
@@ -115,10 +124,7 @@ def push_policy(checkpoint: str | Path, repo_id: str, *, results: str | Path | N
     card = policy_card(folder, repo_id, report)
     with tempfile.TemporaryDirectory(prefix="tavis-policy-") as scratch:
         staged = Path(scratch) / "policy"
-        shutil.copytree(folder, staged)
-        (staged / "README.md").write_text(card)
-        if results is not None:
-            shutil.copyfile(results, staged / RESULTS_NAME)
+        _stage(folder, card, results, staged)
         with hub_errors(repo_id, "model"):
             api = HfApi()
             api.create_repo(repo_id, repo_type="model", private=private, exist_ok=True)
@@ -128,6 +134,14 @@ def push_policy(checkpoint: str | Path, repo_id: str, *, results: str | Path | N
                               commit_message="TAVIS policy checkpoint and model card")
     url = f"{constants.ENDPOINT}/{repo_id}"
     return f"{url}/tree/{quote(branch, safe='')}" if branch else url
+
+
+def _stage(folder: Path, card: str, results: str | Path | None, staged: Path) -> None:
+    """The model repository's content at `staged` (made here): the checkpoint folder, README.md and results.json."""
+    shutil.copytree(folder, staged)
+    (staged / "README.md").write_text(card)
+    if results is not None:
+        shutil.copyfile(results, staged / RESULTS_NAME)
 
 
 def _read_results(path: Path) -> dict:

@@ -283,6 +283,22 @@ def test_push_policy_uploads_the_checkpoint_card_and_results_in_one_commit(check
     assert not (checkpoint / "README.md").exists()  # the checkpoint folder is left as it was
 
 
+def test_push_policy_out_writes_the_upload_ready_folder_without_network_or_login(checkpoint, hub, uploads, tmp_path):
+    from lerobot_tavis.policies.hub import policy_card, push_policy
+
+    results, out = tmp_path / "results.json", tmp_path / "model"
+    out.mkdir()
+    (out / "stale.txt").write_text("from an older card")
+    assert push_policy(checkpoint, POLICY_REPO, results=results, out=out) == str(out)
+    assert not uploads  # no Hub call, and no token needed
+    assert sorted(path.name for path in out.iterdir()) == ["README.md", "config.json", "model.safetensors",
+                                                           "policy_preprocessor.json", "results.json",
+                                                           "train_config.json"]
+    assert (out / "README.md").read_text() == policy_card(checkpoint, POLICY_REPO, RESULTS)
+    assert (out / "results.json").read_bytes() == results.read_bytes()
+    assert not [path for path in tmp_path.iterdir() if path.name.startswith(".")]  # no staging copy left
+
+
 def test_push_policy_refuses_before_uploading(checkpoint, hub, uploads, monkeypatch, tmp_path):
     from lerobot_tavis.policies.hub import push_policy
 
