@@ -23,13 +23,19 @@
 # made once by `tavis noise-state` with seed SEED; needs STATE_INPUT=on; `overfit` ignores it), ACTIONS (absolute;
 # hand_relative: the `act_hand_relative_<CONDITION>_compact` preset, ACT whose chunks hold the arm poses in the frame
 # of the hand as measured when the chunk is planned, observation.state read as that anchor alone, with the time
-# since the episode began as an input; its own budget unless set: STEPS 3200, SAVE_FREQ 800, BATCH 128),
+# since the episode began as an input; its own budget unless set: STEPS 3200, SAVE_FREQ 800, BATCH 128, LR 1e-4;
+# another BATCH, or GPUS > 1, keeps the preset's samples (3200 x 128) and rescales what is not set by the ratio r of
+# BATCH x GPUS, the samples per optimiser step, to the preset's batch: STEPS / r, SAVE_FREQ / r, LR x sqrt(r), the
+# square-root rule for Adam-type optimisers, which keeps the size of the optimiser's noise per sample, where the
+# linear rule, SGD's, would take BATCH 512 to 4e-4; e.g. BATCH=256: 1600 steps, a checkpoint every 400, lr 1.41e-4),
+# LR (ACTIONS=hand_relative: the peak learning rate, `--optimizer.lr`, and ACT's backbone's,
+# `--policy.optimizer_lr_backbone`),
 # POLICY (act; diffusion: with ACTIONS=hand_relative, the only actions it takes, the
 # `diffusion_hand_relative_<CONDITION>_compact` preset, Diffusion Policy denoising horizons in the hand frame on the
 # same budget, its network seeing no state, with the time input; TRAIN_S 1500 s unless set),
 # GPUS (1; N > 1, not with `pair`: `train` runs lerobot-train data-parallel in N processes of `accelerate launch`,
 # one per visible GPU, each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS
-# and SAVE_FREQ by N for the one-GPU budget), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
+# and SAVE_FREQ by N for the one-GPU budget, which ACTIONS=hand_relative does itself), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
 # and reads the frames from it, TAVIS_FRAME_CACHE=1; docs/training.md, "Training at scale"),
 # SPLITS (id: the splits each evaluation plays, comma-separated; table: id for fixed_wrist and id, ood_spatial and
 # ood_init_pose for head_wrist, the baselines table's protocol), DEVICE (cuda; cpu: training and evaluation without
@@ -128,6 +134,14 @@ fi
 case "$GPUS" in
   ''|*[!0-9]*|0) echo "GPUS must be a number of GPUs >= 1, got '$GPUS'" >&2; exit 2 ;;
 esac
+case "${BATCH:-1}" in
+  *[!0-9]*|0) echo "BATCH must be a number of samples >= 1 per GPU, got '$BATCH'" >&2; exit 2 ;;
+esac
+if [ -n "${LR:-}" ] && { [ "$ACTIONS" != hand_relative ] || ! [[ "$LR" =~ ^[0-9]+(\.[0-9]+)?([eE]-?[0-9]+)?$ ]]; }; then
+  echo "LR must be a learning rate such as 1e-4 or 0.0002, with ACTIONS=hand_relative; got '$LR'" \
+    "with ACTIONS=$ACTIONS" >&2
+  exit 2
+fi
 case "$FRAME_CACHE" in
   on|off) ;;
   *) echo "FRAME_CACHE must be on or off, got '$FRAME_CACHE'" >&2; exit 2 ;;
@@ -149,6 +163,26 @@ case "$DEVICE" in
 esac
 SIZE=120x160
 HERE=$(cd "$(dirname "$0")" && pwd)
+
+scaled_budget() {  # scaled_budget PRESET: the lerobot-train arguments of STEPS, SAVE_FREQ, BATCH and LR, those
+  # not set rescaled from the preset's for BATCH x GPUS samples per step (header: ACTIONS=hand_relative)
+  python3 - "$1" "${BATCH:-}" "$GPUS" "${STEPS:-}" "${SAVE_FREQ:-}" "${LR:-}" <<'PY'
+import json, math, sys
+preset = json.load(open(sys.argv[1]))
+batch, gpus, steps, save_freq, lr = sys.argv[2:]
+ratio = int(batch or preset["batch_size"]) * int(gpus) / preset["batch_size"]
+arguments = {"steps": steps, "save_freq": save_freq, "batch_size": batch}
+if ratio != 1:
+    arguments = {"steps": steps or max(1, round(preset["steps"] / ratio)),
+                 "save_freq": save_freq or max(1, round(preset["save_freq"] / ratio)), "batch_size": batch}
+    lr = lr or f"{preset['optimizer']['lr'] * math.sqrt(ratio):.3g}"
+if lr:
+    arguments["optimizer.lr"] = lr
+    if "optimizer_lr_backbone" in preset["policy"]:
+        arguments["policy.optimizer_lr_backbone"] = lr
+print(" ".join(f"--{key}={value}" for key, value in arguments.items() if value))
+PY
+}
 
 choose_video_backend() {  # BACKEND=VIDEO_BACKEND if set, else torchcodec when it loads (with PyAV's FFmpeg if the
   # system has none), else pyav
@@ -294,8 +328,13 @@ case "${1:-}" in
     choose_video_backend
     dataset="$WORK/dataset_$CONDITION"
     if [ -n "$STATE_NOISE" ]; then dataset=$(noisy_copy "$dataset"); fi
-    time train "$dataset" "$WORK/train_$CONDITION" ${STEPS:+--steps=$STEPS} \
-      ${SAVE_FREQ:+--save_freq=$SAVE_FREQ} ${BATCH:+--batch_size=$BATCH}
+    if [ "$ACTIONS" = hand_relative ]; then
+      budget=$(scaled_budget "$(preset)")
+    else
+      budget="${STEPS:+--steps=$STEPS} ${SAVE_FREQ:+--save_freq=$SAVE_FREQ} ${BATCH:+--batch_size=$BATCH}"
+    fi
+    read -ra budget <<< "$budget"
+    time train "$dataset" "$WORK/train_$CONDITION" "${budget[@]}"
     ;;
   eval)  # every complete checkpoint (up to the one `last` points at), so it may run while training goes on
     link=$(readlink "$WORK/train_$CONDITION/checkpoints/last") 2>/dev/null || exit 0  # no checkpoint yet

@@ -9,9 +9,9 @@ Both build the run exactly as lerobot-train does, from the preset (`--preset`, d
 the extra arguments, on a dataset made by `train_throughput.py data`:
 
 - `loader` iterates LeRobot's DataLoader (LeRobot's `make_dataset`, its worker settings) and also does what
-  lerobot-train's main process does with each batch before the update (uint8 frames to float on the CPU, the
-  policy's preprocessor, which moves the batch to the GPU). It prints samples/s of the workers alone and of the
-  whole data path, after `--skip` warm-up batches.
+  lerobot-train's main process does with each batch before the update: the copy to the device that Accelerate's
+  prepared DataLoader makes (`send_to_device`), uint8 frames to float there, the policy's preprocessor. It prints
+  samples/s of the workers alone and of the whole data path, after `--skip` warm-up batches.
 - `update` runs the policy's forward, backward and optimiser step (Accelerate, mixed precision as lerobot-train
   sets it) on one batch held on the GPU, so no loading at all: samples/s of the GPU work alone.
 
@@ -58,6 +58,7 @@ def endless(loader):
 
 
 def profile_loader(args: argparse.Namespace, extra: list[str]) -> None:
+    from accelerate.utils import send_to_device
     from lerobot.datasets.factory import make_dataset
     from lerobot.policies.factory import make_pre_post_processors
 
@@ -75,6 +76,7 @@ def profile_loader(args: argparse.Namespace, extra: list[str]) -> None:
             start = time.perf_counter()
             batch = next(batches)
             fetched = time.perf_counter()
+            batch = send_to_device(batch, torch.device(args.device))
             for key in dataset.meta.camera_keys:
                 if key in batch and batch[key].dtype == torch.uint8:
                     batch[key] = batch[key].to(dtype=torch.float32) / 255.0

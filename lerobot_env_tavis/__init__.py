@@ -3,7 +3,7 @@
 lerobot-train and lerobot-eval load them before their plugins; the robot and teleop CLIs stay without them. Elsewhere
 `lerobot_tavis.policies.register_policy_types()` registers the policy types. In these CLIs a bad `--env.*` value is
 one line instead of a traceback, and so is LeRobot's warning that torchcodec cannot load (no system FFmpeg). With
-`TAVIS_FRAME_CACHE=1`, lerobot-train (which has loaded LeRobot's dataset factory by then) reads video frames from the
+`TAVIS_FRAME_CACHE=1` (or `float32`), lerobot-train (which has loaded LeRobot's dataset factory by then) reads video frames from the
 frame cache (`lerobot_tavis.dataset_tools.cached_dataset`)."""
 
 import sys
@@ -21,9 +21,9 @@ if "lerobot.policies" in sys.modules:
     register_policy_types()
 
 if "lerobot.datasets.factory" in sys.modules:
-    from lerobot_tavis.dataset_tools.cached_dataset import switched_on, use_frame_cache
+    from lerobot_tavis.dataset_tools.cached_dataset import frame_cache_mode, use_frame_cache
 
-    if switched_on():
-        use_frame_cache()
+    if mode := frame_cache_mode():
+        use_frame_cache(mode)
 
 __all__ = ["TavisEnvConfig"]

@@ -151,6 +151,36 @@ def test_policy_diffusion_trains_the_hand_frame_diffusion_preset_on_its_budget(t
     assert f"--config_path={shipped} " in train and not re.search(r"--(steps|save_freq|batch_size)=", train)
 
 
+@pytest.mark.parametrize(("settings", "budget"), [
+    (dict(BATCH="256"), "--steps=1600 --save_freq=400 --batch_size=256 --optimizer.lr=0.000141 "
+                        "--policy.optimizer_lr_backbone=0.000141"),  # the preset's 409,600 samples, lr x sqrt(2)
+    (dict(GPUS="4"), "--steps=800 --save_freq=200 --optimizer.lr=0.0002 --policy.optimizer_lr_backbone=0.0002"),
+    (dict(BATCH="64", STEPS="5000", LR="5e-5"), "--steps=5000 --save_freq=1600 --batch_size=64 --optimizer.lr=5e-5 "
+                                                "--policy.optimizer_lr_backbone=5e-5"),  # what is set wins
+    (dict(BATCH="128", LR="2e-4"), "--batch_size=128 --optimizer.lr=2e-4 --policy.optimizer_lr_backbone=2e-4"),
+])
+def test_hand_relative_batch_keeps_the_presets_samples_with_the_square_root_learning_rate(tmp_path, settings,
+                                                                                         budget):
+    calls = _run(tmp_path, "train", ACTIONS="hand_relative", PRESET_FILE=str(preset_path(
+        "act_hand_relative_head_wrist_compact")), **settings)
+    (train,) = [call.split(" | ")[0] for call in calls if call.startswith(("lerobot-train", "accelerate"))]
+    assert train.endswith(f" --output_dir={tmp_path}/work/train_head_wrist {budget}")
+
+
+@pytest.mark.parametrize(("settings", "message"), [
+    (dict(BATCH="0"), "BATCH must be a number of samples >= 1 per GPU, got '0'"),
+    (dict(BATCH="12x"), "BATCH must be a number of samples >= 1 per GPU, got '12x'"),
+    (dict(ACTIONS="hand_relative", LR="fast"), "LR must be a learning rate such as 1e-4 or 0.0002, with "
+                                               "ACTIONS=hand_relative; got 'fast' with ACTIONS=hand_relative"),
+    (dict(LR="1e-4"), "LR must be a learning rate such as 1e-4 or 0.0002, with ACTIONS=hand_relative; got '1e-4' "
+                      "with ACTIONS=absolute"),
+])
+def test_a_bad_batch_or_learning_rate_is_refused_before_anything_runs(tmp_path, settings, message):
+    refused = _stubbed(tmp_path, "train", **settings)
+    assert refused.returncode == 2 and message in refused.stderr
+    assert not (tmp_path / "calls.log").exists()
+
+
 @pytest.mark.parametrize(("settings", "message"), [
     (dict(ACTIONS="hand_relative", STATE_INPUT="on"), "ACTIONS=hand_relative takes STATE_INPUT=off alone"),
     (dict(ACTIONS="relative", STATE_INPUT="off"), "ACTIONS must be absolute or hand_relative, got 'relative'"),

@@ -11,27 +11,35 @@ from pathlib import Path
 BENCHMARK = Path(__file__).resolve().parents[1] / "benchmarks" / "train_throughput.py"
 
 
-def _run(setting, gpus, cache, wall_sps, utilisation):
+def _run(setting, gpus, cache, wall_sps, utilisation, batch=128):
     return {"setting": setting, "gpus": gpus, "cache": cache, "wall_sps": wall_sps, "sps": wall_sps,
-            "gpu_utilisation": utilisation, "batch_per_gpu": 128, "video_backend": "torchcodec", "update": 0.05,
-            "data": 0.01}
+            "gpu_utilisation": utilisation, "batch_per_gpu": batch, "video_backend": "torchcodec", "update": 0.05,
+            "data": 0.01, "device": "cuda"}
 
 
-def test_the_scale_table_compares_each_gpu_count_with_one_gpu_of_the_same_frames(benchmark_script, tmp_path):
+def test_the_scale_table_compares_each_run_with_decoded_frames_on_one_gpu_at_the_same_batch(benchmark_script,
+                                                                                            tmp_path):
     throughput = benchmark_script("train_throughput")
-    runs = [_run("act", 1, True, 2000.0, {"0": 90.0}), _run("act", 2, True, 3800.0, {"0": 80.0, "1": 70.0}),
-            _run("act", 1, False, 800.0, {"0": 40.0}), _run("act", 4, False, 2400.0, {})]
+    runs = [_run("act", 1, "off", 800.0, {"0": 40.0}), _run("act", 1, "uint8", 2000.0, {"0": 90.0}),
+            _run("act", 2, "uint8", 3800.0, {"0": 80.0, "1": 70.0}), _run("act", 4, "float32", 2400.0, {}),
+            _run("act", 1, "off", 1000.0, {"0": 50.0}, batch=256), _run("act", 1, "uint8", 2500.0, {}, batch=256)]
     (tmp_path / "scale").mkdir()
     for index, run in enumerate(runs):
         (tmp_path / "scale" / f"{index}.json").write_text(json.dumps(run))
     throughput.write_scale_report(tmp_path, budget=409_600, episodes=24)
     rows = [line.split(" | ") for line in (tmp_path / "scale.md").read_text().splitlines() if line.startswith("| act")]
-    table = {(row[1], row[2]): row for row in rows}
-    assert table["2", "frame cache"][5] == "1.90"  # 3800 / 2000
-    assert table["2", "frame cache"][7] == "75; 70"  # mean over both GPUs; the lower one
-    assert table["2", "frame cache"][10] == "1.8 |"  # 409 600 samples at 3800 samples/s, minutes
-    assert table["4", "decoded (torchcodec)"][5] == "3.00" and table["4", "decoded (torchcodec)"][7] == "n/a"
-    assert len(json.loads((tmp_path / "scale.json").read_text())["runs"]) == 4
+    table = {(row[1], row[2], row[3]): row for row in rows}
+    assert [row[1:4] for row in rows] == [["1", "decoded (torchcodec)", "128"], ["1", "cache, uint8", "128"],
+                                          ["2", "cache, uint8", "128"], ["4", "cache, float32 from workers", "128"],
+                                          ["1", "decoded (torchcodec)", "256"], ["1", "cache, uint8", "256"]]
+    assert table["2", "cache, uint8", "128"][5] == "4.75"  # 3800 / 800
+    assert table["2", "cache, uint8", "128"][7] == "75; 70"  # mean over both GPUs; the lower one
+    assert table["2", "cache, uint8", "128"][10] == "1.8 |"  # 409 600 samples at 3800 samples/s, minutes
+    assert table["4", "cache, float32 from workers", "128"][5] == "3.00"
+    assert table["4", "cache, float32 from workers", "128"][7] == "n/a"
+    assert table["1", "cache, uint8", "256"][5] == "2.50"  # against batch 256 decoded: 2500 / 1000
+    assert len(json.loads((tmp_path / "scale.json").read_text())["runs"]) == 6
+    assert "not a measurement" not in (tmp_path / "scale.md").read_text()
 
 
 def test_utilisation_counts_only_the_samples_inside_the_window(benchmark_script):
@@ -46,3 +54,13 @@ def test_help_names_the_scale_stage():
     result = subprocess.run([sys.executable, str(BENCHMARK), "--help"], capture_output=True, text=True, env=env,
                             check=True, timeout=120)
     assert "scale" in result.stdout and "--gpus" in result.stdout and "--cache" in result.stdout
+    assert "--warm-up" in result.stdout and "float32" in result.stdout
+
+
+def test_scale_refuses_an_unknown_setting_in_one_line():
+    env = {**os.environ, "PYTHONPATH": str(BENCHMARK.parents[1])}
+    result = subprocess.run([sys.executable, str(BENCHMARK), "scale", "--work", "/nonexistent", "--settings",
+                             "act_nonsense"], capture_output=True, text=True, env=env, timeout=120)
+    assert result.returncode == 2
+    assert result.stderr.splitlines()[-1].startswith("train_throughput.py: error: --settings: unknown preset "
+                                                     "'act_nonsense'; presets: ")

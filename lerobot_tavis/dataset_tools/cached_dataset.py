@@ -5,12 +5,12 @@ Only the frame lookup changes. LeRobot's reader still chooses each sample's rows
 other features and image transforms; where it would decode a camera's frames at a list of timestamps, this reader
 takes the cache's rows at those timestamps (the nearest within `tolerance_s`, as LeRobot's decoders choose).
 
-The frames come back as float32 in [0, 1], the values LeRobot's decoders return unless asked for uint8 (`x / 255`
-of the same uint8 frame). lerobot-train asks its datasets for uint8 frames and converts every camera's batch to
-float in its main process, between two updates; LeRobot 0.6's loop converts uint8 camera frames on the CPU before
-its preprocessor, whose device step casts floating-point tensors only, so the conversion cannot move to the GPU
-without changing LeRobot's loop. Float frames from the loader workers leave the main process only the copy to the
-GPU, from memory the DataLoader has pinned.
+The frames come back as LeRobot's decoders return them: uint8 where the dataset is asked for uint8 (`return_uint8`,
+as lerobot-train asks), else float32 in [0, 1] (`x / 255` of the same uint8 frame). lerobot-train converts uint8
+camera batches to float itself, after Accelerate has moved the batch to the training device, so uint8 frames travel
+from the loader workers to the GPU at one byte per value. `TAVIS_FRAME_CACHE=float32` makes the loader workers
+convert instead (four times the bytes through the worker queue, pinned memory and the copy to the GPU): the
+measurement's alternative (benchmarks/train_throughput.py `scale`).
 """
 
 from __future__ import annotations
@@ -26,6 +26,9 @@ from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot_tavis.dataset_tools.frame_cache import FrameCache, StaleFrameCacheError
 
 SWITCH = "TAVIS_FRAME_CACHE"
+SWITCH_VALUES = {"1": "read video frames from the frame cache",
+                 "float32": "the same, converted to float32 in the loader workers",
+                 "0": "decode them"}
 
 
 class CachedFrameReader(DatasetReader):
@@ -37,20 +40,22 @@ class CachedFrameReader(DatasetReader):
 
     def _query_videos(self, query_timestamps: dict[str, list[float]], ep_idx: int) -> dict[str, torch.Tensor]:
         """Per camera key, the frames at the timestamps (s, within episode `ep_idx`): (channels, height, width) for
-        one timestamp, (timestamps, channels, height, width) for several, float32 in [0, 1], as LeRobot's."""
+        one timestamp, (timestamps, channels, height, width) for several; uint8 with `return_uint8`, else float32
+        in [0, 1], as LeRobot's."""
         episode = self._meta.episodes[ep_idx]
         start, end = int(episode["dataset_from_index"]), int(episode["dataset_to_index"])
         frames = {}
         for key, timestamps in query_timestamps.items():
             rows = self.frame_cache.rows(start, end, timestamps, self._tolerance_s)
-            frames[key] = (torch.from_numpy(self.frame_cache.frames(key, rows)).to(torch.float32) / 255.0).squeeze(0)
+            frames[key] = torch.from_numpy(self.frame_cache.frames(key, rows)).squeeze(0)
+            if not self._return_uint8:
+                frames[key] = frames[key].to(torch.float32) / 255.0
         return frames
 
 
 class FrameCachedDataset(LeRobotDataset):
-    """A LeRobotDataset (same arguments) reading its video frames from the frame cache beside its root, as float32
-    in [0, 1] whatever `return_uint8` asks (module docstring); refuses a missing or stale cache
-    (StaleFrameCacheError)."""
+    """A LeRobotDataset (same arguments) reading its video frames from the frame cache beside its root, in the type
+    `return_uint8` asks (module docstring); refuses a missing or stale cache (StaleFrameCacheError)."""
 
     def __init__(self, repo_id: str, root=None, **dataset_arguments):
         super().__init__(repo_id, root=root, **dataset_arguments)
@@ -78,20 +83,29 @@ class TrainingFrameCachedDataset(FrameCachedDataset):
             raise SystemExit(f"lerobot-train: error: {error}") from None
 
 
-def switched_on() -> bool:
-    """Whether TAVIS_FRAME_CACHE asks for the frame cache: 1 yes, 0, empty or unset no, anything else stops the
-    process with one line (a misspelt switch must not train without the cache unnoticed)."""
+class TrainingFloatFrameCachedDataset(TrainingFrameCachedDataset):
+    """TrainingFrameCachedDataset whose loader workers convert the frames to float32 in [0, 1], whatever
+    lerobot-train asks (`TAVIS_FRAME_CACHE=float32`)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **{**kwargs, "return_uint8": False})
+
+
+def frame_cache_mode() -> str | None:
+    """What TAVIS_FRAME_CACHE asks for: "1" (frames from the cache, as lerobot-train asks for them: uint8),
+    "float32" (from the cache, converted in the loader workers), None (0, empty or unset: decode); anything else
+    stops the process with one line (a misspelt switch must not train without the cache unnoticed)."""
     value = os.environ.get(SWITCH, "0")
-    if value not in ("", "0", "1"):
-        sys.exit(f"{SWITCH}={value!r}: set it to 1 (read video frames from the frame cache) or 0 (decode them)")
-    return value == "1"
+    if value not in (*SWITCH_VALUES, ""):
+        choices = ", ".join(f"{choice} ({meaning})" for choice, meaning in SWITCH_VALUES.items())
+        sys.exit(f"{SWITCH}={value!r}: set it to {choices}")
+    return None if value in ("", "0") else value
 
 
-def use_frame_cache() -> None:
-    """Make lerobot-train read video frames from the frame cache: its datasets (training, and the held-out split
-    with `--dataset.eval_split`) are built by `lerobot.datasets.factory`, which this points at
-    TrainingFrameCachedDataset."""
+def use_frame_cache(mode: str) -> None:
+    """Make lerobot-train read video frames from the frame cache in `mode` (`frame_cache_mode`): its datasets
+    (training, and the held-out split with `--dataset.eval_split`) are built by `lerobot.datasets.factory`, which
+    this points at TrainingFrameCachedDataset (or its float32 variant)."""
     import lerobot.datasets.factory as factory
 
-    factory.LeRobotDataset = TrainingFrameCachedDataset
-
+    factory.LeRobotDataset = TrainingFloatFrameCachedDataset if mode == "float32" else TrainingFrameCachedDataset

@@ -39,35 +39,80 @@ def dataset_root(tmp_path_factory):
     return root
 
 
-def test_cached_samples_are_lerobots_decoded_samples_without_decoding(dataset_root, monkeypatch):
+def _assert_same_sample(got: dict, want: dict, index: int) -> None:
+    assert got.keys() == want.keys()
+    assert got["timestamp"] == want["timestamp"] and got["episode_index"] == want["episode_index"]
+    for key, value in want.items():
+        if isinstance(value, torch.Tensor):
+            assert got[key].dtype == value.dtype and torch.equal(got[key], value), (index, key)
+        else:
+            assert got[key] == value, (index, key)
+
+
+@pytest.mark.parametrize("return_uint8", [True, False], ids=["uint8 as lerobot-train asks", "float32"])
+def test_cached_samples_are_lerobots_decoded_samples_without_decoding(dataset_root, monkeypatch, return_uint8):
     from lerobot.datasets import dataset_reader
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     from lerobot_tavis.dataset_tools.cached_dataset import FrameCachedDataset
 
-    decoded = LeRobotDataset("local/tiny", root=dataset_root, video_backend="pyav", delta_timestamps=DELTA_TIMESTAMPS)
-    expected = [decoded[index] for index in range(len(decoded))]  # frames float32 in [0, 1], LeRobot's decoder
+    decoded = LeRobotDataset("local/tiny", root=dataset_root, video_backend="pyav", delta_timestamps=DELTA_TIMESTAMPS,
+                             return_uint8=return_uint8)
+    expected = [decoded[index] for index in range(len(decoded))]  # LeRobot's decoder's frames
     assert decoded.num_episodes == 2
     assert any(sample["observation.images.head_is_pad"].any() for sample in expected)
+    assert expected[0]["observation.images.head"].dtype == (torch.uint8 if return_uint8 else torch.float32)
 
     def no_decoding(*args, **kwargs):
         raise AssertionError("the frame cache decoded a video")
 
     monkeypatch.setattr(dataset_reader, "decode_video_frames", no_decoding)
     cached = FrameCachedDataset("local/tiny", root=dataset_root, video_backend="pyav",
-                                delta_timestamps=DELTA_TIMESTAMPS, return_uint8=True)  # as lerobot-train asks
+                                delta_timestamps=DELTA_TIMESTAMPS, return_uint8=return_uint8)
     assert len(cached) == len(expected)
     cached[0]  # its memory maps are open now; the DataLoader pickles the dataset for its spawned workers, which
     in_worker = pickle.loads(pickle.dumps(cached))  # open them again
     for index, want in enumerate(expected):
-        got = (cached if index % 2 else in_worker)[index]
-        assert got.keys() == want.keys()
-        assert got["timestamp"] == want["timestamp"] and got["episode_index"] == want["episode_index"]
+        _assert_same_sample((cached if index % 2 else in_worker)[index], want, index)
+
+
+def test_the_preprocessed_batch_is_the_same_from_uint8_float32_and_decoded_frames(dataset_root):
+    """What the policy receives in lerobot-train (its loop turns uint8 camera batches into float32 / 255 after
+    Accelerate has put the batch on the device, then runs the policy's preprocessor): the same to the bit on CPU
+    whether the frames were decoded, come from the cache as uint8 or as float32 from the loader workers. (On a GPU
+    the loop's division may round the last bit differently from the workers' on the CPU.)"""
+    from lerobot.configs.types import FeatureType, PolicyFeature
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    from lerobot_tavis.dataset_tools.cached_dataset import FrameCachedDataset, TrainingFloatFrameCachedDataset
+    from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import ACTHandRelativeConfig
+    from lerobot_tavis.policies.act_hand_relative.processor_act_hand_relative import (
+        make_act_hand_relative_pre_post_processors)
+
+    arguments = {"root": dataset_root, "video_backend": "pyav", "delta_timestamps": DELTA_TIMESTAMPS,
+                 "return_uint8": True}  # as lerobot-train's dataset factory asks
+    datasets = {"decoded": LeRobotDataset("local/tiny", **arguments),
+                "cache uint8": FrameCachedDataset("local/tiny", **arguments),
+                "cache float32": TrainingFloatFrameCachedDataset("local/tiny", **arguments)}
+    config = ACTHandRelativeConfig(device="cpu", input_features={
+        key: PolicyFeature(FeatureType.VISUAL, (3, *TINY)) for key in CAMERA_KEYS},
+        output_features={"action": PolicyFeature(FeatureType.ACTION, (19,))})
+    preprocessor, _ = make_act_hand_relative_pre_post_processors(config, datasets["decoded"].meta.stats)
+    batches = {}
+    for name, dataset in datasets.items():
+        batch = next(iter(torch.utils.data.DataLoader(dataset, batch_size=16, shuffle=False)))
+        assert batch[CAMERA_KEYS[0]].dtype == (torch.float32 if name == "cache float32" else torch.uint8)
+        for key in dataset.meta.camera_keys:  # lerobot-train's loop
+            if batch[key].dtype == torch.uint8:
+                batch[key] = batch[key].to(dtype=torch.float32) / 255.0
+        batches[name] = preprocessor(batch)
+    want = batches.pop("decoded")
+    assert want[CAMERA_KEYS[0]].dtype == torch.float32
+    for name, got in batches.items():
+        assert got.keys() == want.keys(), name
         for key, value in want.items():
             if isinstance(value, torch.Tensor):
-                assert got[key].dtype == value.dtype and torch.equal(got[key], value), (index, key)
-            else:
-                assert got[key] == value, (index, key)
+                assert got[key].dtype == value.dtype and torch.equal(got[key], value), (name, key)
 
 
 def test_a_cache_of_an_earlier_state_of_the_dataset_is_refused_in_one_line(dataset_root, tmp_path, capsys):

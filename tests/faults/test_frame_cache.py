@@ -46,23 +46,26 @@ def test_lerobot_train_refuses_a_stale_frame_cache_in_one_line(dataset_root, tmp
     assert "Traceback" not in run.stderr and not (tmp_path / "train" / "checkpoints").exists()
 
 
-@pytest.mark.parametrize(("value", "on"), [("1", True), ("0", False), (None, False), ("", False), ("yes", None),
-                                           ("true", None)])
-def test_the_switch_is_1_or_0_and_anything_else_stops_in_one_line(monkeypatch, value, on):
-    """The plugin module asks `switched_on()` in lerobot-train's process (which the stale-cache test runs)."""
-    from lerobot_tavis.dataset_tools.cached_dataset import switched_on
+STOPS = object()
+
+
+@pytest.mark.parametrize(("value", "mode"), [("1", "1"), ("float32", "float32"), ("0", None), (None, None),
+                                             ("", None), ("yes", STOPS), ("true", STOPS), ("uint8", STOPS)])
+def test_the_switch_is_1_float32_or_0_and_anything_else_stops_in_one_line(monkeypatch, value, mode):
+    """The plugin module asks `frame_cache_mode()` in lerobot-train's process (which the stale-cache test runs)."""
+    from lerobot_tavis.dataset_tools.cached_dataset import frame_cache_mode
 
     if value is None:
         monkeypatch.delenv("TAVIS_FRAME_CACHE", raising=False)
     else:
         monkeypatch.setenv("TAVIS_FRAME_CACHE", value)
-    if on is not None:
-        assert switched_on() is on
+    if mode is not STOPS:
+        assert frame_cache_mode() == mode
         return
     with pytest.raises(SystemExit) as stop:
-        switched_on()
-    assert stop.value.code == (f"TAVIS_FRAME_CACHE={value!r}: set it to 1 (read video frames from the frame "
-                               "cache) or 0 (decode them)")
+        frame_cache_mode()
+    assert stop.value.code == (f"TAVIS_FRAME_CACHE={value!r}: set it to 1 (read video frames from the frame cache), "
+                               "float32 (the same, converted to float32 in the loader workers), 0 (decode them)")
 
 
 def test_cache_frames_refuses_what_it_cannot_cache_in_one_line_and_writes_nothing(tmp_path):
