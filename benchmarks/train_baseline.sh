@@ -13,7 +13,7 @@
 # FILM (episodes filmed per evaluation: 2, as each filmed sub-env also renders the overview), EVAL_OPTIONS (more
 # `tavis eval` arguments, e.g. "--policy-option temporal_ensemble_coeff=0.01 --policy-option n_action_steps=1" for
 # ACT's temporal ensembling), TRAIN_OPTIONS (more lerobot-train arguments, e.g. "--policy.chunk_size=40
-# --policy.n_action_steps=20"), EVAL_NAME (the evaluations' folder under WORK: eval_<CONDITION>), CHECKPOINTS (which
+# --policy.n_action_steps=20"), EVAL_NAME (the evaluations' folder under WORK: eval_<RUN>), CHECKPOINTS (which
 # `eval` takes: all, last, or one training step such as 1600), STATE_INPUT (on; off: the policy sees its cameras
 # alone, a copy of the preset without the observation.state input written to WORK, to tell a policy that copies its
 # own pose from one that needs it; off is the default with ACTIONS=hand_relative and the only value it takes),
@@ -32,7 +32,9 @@
 # `--policy.optimizer_lr_backbone`),
 # POLICY (act; diffusion: with ACTIONS=hand_relative, the only actions it takes, the
 # `diffusion_hand_relative_<CONDITION>_compact` preset, Diffusion Policy denoising horizons in the hand frame on the
-# same budget, its network seeing no state, with the time input; TRAIN_S 1500 s unless set),
+# same budget, its network seeing no state, with the time input; TRAIN_S 1500 s unless set; its training and
+# evaluations go to train_diffusion_<CONDITION> and eval_diffusion_<CONDITION>, so it shares WORK's recording and
+# datasets with the ACT runs: RUN below is diffusion_<CONDITION>, else <CONDITION>),
 # GPUS (1; N > 1, not with `pair`: `train` runs lerobot-train data-parallel in N processes of `accelerate launch`,
 # one per visible GPU, each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS
 # and SAVE_FREQ by N for the one-GPU budget, which ACTIONS=hand_relative does itself), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
@@ -76,7 +78,6 @@ EVAL_EPISODES=${EVAL_EPISODES:-96}
 EVAL_JOBS=${EVAL_JOBS:-4}
 EVAL_BATCH=${EVAL_BATCH:-12}
 FILM=${FILM:-2}
-EVAL_NAME=${EVAL_NAME:-eval_$CONDITION}
 SEED=${SEED:-1000}
 CHECKPOINTS=${CHECKPOINTS:-all}
 ACTIONS=${ACTIONS:-absolute}
@@ -122,6 +123,8 @@ case "$POLICY" in
     fi ;;
   *) echo "POLICY must be act or diffusion, got '$POLICY'" >&2; exit 2 ;;
 esac
+if [ "$POLICY" = diffusion ]; then RUN=diffusion_$CONDITION; else RUN=$CONDITION; fi  # names its train_ and eval_
+EVAL_NAME=${EVAL_NAME:-eval_$RUN}
 if [ -n "$STATE_NOISE" ] && ! [[ "$STATE_NOISE" =~ ^[0-9]+(\.[0-9]+)?,[0-9]+(\.[0-9]+)?$ ]]; then
   echo "STATE_NOISE must be empty (off) or POSITION_M,ROTATION_DEG, two decimal numbers >= 0 such as 0.02,5;" \
     "got '$STATE_NOISE'" >&2
@@ -304,7 +307,7 @@ case "${1:-}" in
     ;;
   cell)
     "$0" data
-    stopped="$WORK/train_$CONDITION.stopped"
+    stopped="$WORK/train_$RUN.stopped"
     rm -f "$stopped"
     ( if [ "$ACTIONS" = absolute ]; then  # the hand-frame preset holds its own budget
         export BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1600} STEPS=${STEPS:-4800}
@@ -334,12 +337,12 @@ case "${1:-}" in
       budget="${STEPS:+--steps=$STEPS} ${SAVE_FREQ:+--save_freq=$SAVE_FREQ} ${BATCH:+--batch_size=$BATCH}"
     fi
     read -ra budget <<< "$budget"
-    time train "$dataset" "$WORK/train_$CONDITION" "${budget[@]}"
+    time train "$dataset" "$WORK/train_$RUN" "${budget[@]}"
     ;;
   eval)  # every complete checkpoint (up to the one `last` points at), so it may run while training goes on
-    link=$(readlink "$WORK/train_$CONDITION/checkpoints/last") 2>/dev/null || exit 0  # no checkpoint yet
+    link=$(readlink "$WORK/train_$RUN/checkpoints/last") 2>/dev/null || exit 0  # no checkpoint yet
     last=$(basename "$link")
-    for checkpoint in "$WORK/train_$CONDITION"/checkpoints/[0-9]*; do
+    for checkpoint in "$WORK/train_$RUN"/checkpoints/[0-9]*; do
       (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
       case "$CHECKPOINTS" in
         all) ;;
@@ -369,10 +372,10 @@ if seeds != list(range(100_000, 100_008)):
 PY
     convert "$WORK/overfit/raw" "$WORK/overfit/dataset_$CONDITION"
     steps=${OVERFIT_STEPS:-3000}
-    time train "$WORK/overfit/dataset_$CONDITION" "$WORK/overfit/train_$CONDITION" --steps="$steps" \
+    time train "$WORK/overfit/dataset_$CONDITION" "$WORK/overfit/train_$RUN" --steps="$steps" \
       --save_freq="$steps" --batch_size=32
-    evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/train_seeds" 100000 8
-    evaluate "$WORK/overfit/train_$CONDITION/checkpoints/last" "$WORK/overfit/eval_$CONDITION/new_seeds" 1000 8
+    evaluate "$WORK/overfit/train_$RUN/checkpoints/last" "$WORK/overfit/eval_$RUN/train_seeds" 100000 8
+    evaluate "$WORK/overfit/train_$RUN/checkpoints/last" "$WORK/overfit/eval_$RUN/new_seeds" 1000 8
     ;;
   *)
     echo "usage: $0 pair|cell|data|train|eval|overfit" >&2

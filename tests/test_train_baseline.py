@@ -149,6 +149,10 @@ def test_policy_diffusion_trains_the_hand_frame_diffusion_preset_on_its_budget(t
     assert "tavis presets diffusion_hand_relative_fixed_wrist_compact | gpu= egl=" in calls
     (train,) = [call for call in calls if call.startswith("lerobot-train")]
     assert f"--config_path={shipped} " in train and not re.search(r"--(steps|save_freq|batch_size)=", train)
+    # beside the ACT runs of the same WORK: its own training and evaluation folders
+    assert f"--output_dir={tmp_path}/work/train_diffusion_fixed_wrist " in train
+    evals = sorted(call.split(" | ")[0].split(" --out ")[1] for call in calls if call.startswith("tavis eval"))
+    assert evals == [f"{tmp_path}/work/eval_diffusion_fixed_wrist/step_{step}" for step in (1500, 3000)]
 
 
 @pytest.mark.parametrize(("settings", "budget"), [

@@ -1,10 +1,15 @@
-"""Shared by the hand-frame policy tests: made-up episodes and a dataset's data files holding them."""
+"""Shared by the hand-frame policy tests: made-up episodes and a dataset's data files holding them; a recorded
+demonstration and its replay by a checkpoint on the env."""
+
+import json
+from types import SimpleNamespace
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
-from lerobot.utils.constants import OBS_STATE
+import torch
+from lerobot.utils.constants import ACTION, OBS_STATE
 
 from lerobot_tavis import canonical
 
@@ -35,3 +40,48 @@ def dataset_root(tmp_path):
         (tmp_path / "data/chunk-000").mkdir(parents=True, exist_ok=True)
         pq.write_table(table, tmp_path / f"data/chunk-000/{name}.parquet")
     return tmp_path, [(a.astype(np.float32).astype(float), s.astype(np.float32).astype(float)) for a, s in episodes]
+
+
+@pytest.fixture(scope="session")
+def demonstration(tmp_path_factory):
+    """One conditional_pick demonstration (GR1T2) converted with the head camera at 32x32: the dataset's `root`, the
+    episode's `seed`, its `actions` and `states` (T, 19, float32 tensors) in frame order."""
+    import pandas as pd
+
+    from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG, ConvertConfig, convert
+    from lerobot_tavis.dataset_tools.record import RecordConfig, record
+
+    scratch = tmp_path_factory.mktemp("demonstration")
+    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
+           progress=False)
+    root = convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=(32, 32),
+                                 cameras=("head",)), progress=False)
+    (entry,) = json.loads((root / CONVERSION_LOG).read_text())["episodes"]
+    frames = pd.read_parquet(next((root / "data").rglob("*.parquet"))).sort_values("frame_index")
+    actions, states = (torch.tensor(np.stack(frames[key].to_numpy()), dtype=torch.float32)
+                       for key in (ACTION, OBS_STATE))
+    return SimpleNamespace(root=root, seed=entry["seed"], actions=actions, states=states)
+
+
+def replay(checkpoint, demonstration) -> tuple[bool, float]:
+    """The checkpoint acting on the env from the demonstration's seed through `PolicyDriver` (as lerobot-eval runs
+    it), the last recorded action held for one second more: whether it succeeded, and the largest distance (m) of
+    an executed arm position target from the recorded one of the same step."""
+    from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.viewer import PolicyDriver
+
+    actions = demonstration.actions
+    driver = PolicyDriver(checkpoint)
+    env = TavisEnv("conditional_pick", "gr1t2", camera_mode="head_only", image_size=(32, 32))
+    observation, _ = env.reset(seed=demonstration.seed)
+    driver.reset()
+    errors_m, success = [], False
+    for step in range(len(actions) + 20):
+        action = driver.act(observation, env.task_description)
+        recorded = actions[min(step, len(actions) - 1)].numpy()
+        errors_m.append(max(np.linalg.norm(action[arm.position] - recorded[arm.position]) for arm in canonical.ARMS))
+        observation, _, success, _, _ = env.step(action)
+        if success:
+            break
+    env.close()
+    return success, max(errors_m)

@@ -19,7 +19,7 @@ from lerobot_tavis.policies.act_hand_relative.modeling_act_hand_relative import 
 from lerobot_tavis.policies.hand_frame import to_hand_frame
 from lerobot_tavis.policies.hand_frame_statistics import hand_frame_statistics
 from lerobot_tavis.policies.hand_relative import EPS
-from tests.policies.conftest import made_up_episode
+from tests.policies.conftest import made_up_episode, replay
 
 CHUNK = 4
 IMAGE = "observation.images.head"
@@ -254,35 +254,20 @@ def test_a_checkpoint_keeps_the_statistics_and_lerobot_finds_the_policy_and_its_
     torch.testing.assert_close(processed[OBS_STATE], raw_state)  # the anchor reaches the policy un-normalised
 
 
-def test_chunks_planned_on_recorded_states_land_on_the_recorded_actions_when_anchored_on_the_env(tmp_path,
+def test_chunks_planned_on_recorded_states_land_on_the_recorded_actions_when_anchored_on_the_env(demonstration,
+                                                                                                 tmp_path,
                                                                                                  monkeypatch):
     """The anchor a policy learns on (the dataset's observation.state) is the one it acts on (the env's agent_pos
     through LeRobot's observation conversion and the processors): an oracle network that plans every chunk from the
     recorded actions and states, executed by a checkpoint in `PolicyDriver`, repeats the demonstration."""
-    import json
-
-    import pandas as pd
     from lerobot.policies.factory import make_pre_post_processors
 
-    from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG, ConvertConfig, convert
-    from lerobot_tavis.dataset_tools.record import RecordConfig, record
-    from lerobot_tavis.envs.env import TavisEnv
-    from lerobot_tavis.viewer import PolicyDriver
-
-    monkeypatch.setenv("MUJOCO_GL", "egl")
-    record(RecordConfig(out_dir=tmp_path / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
-           progress=False)
-    root = convert(ConvertConfig(tmp_path / "raw", "local/tiny", tmp_path / "dataset", image_size=(32, 32),
-                                 cameras=("head",)), progress=False)
-    (entry,) = json.loads((root / CONVERSION_LOG).read_text())["episodes"]
-    frames = pd.read_parquet(next((root / "data").rglob("*.parquet"))).sort_values("frame_index")
-    actions = torch.tensor(np.stack(frames["action"].to_numpy()), dtype=torch.float32)
-    states = torch.tensor(np.stack(frames[OBS_STATE].to_numpy()), dtype=torch.float32)
+    actions, states = demonstration.actions, demonstration.states
     stats = {ACTION: {"mean": actions.mean(0).numpy(), "std": actions.std(0).numpy()},
              IMAGE: {"mean": np.full((3, 1, 1), 0.5), "std": np.full((3, 1, 1), 0.25)}}
     chunk, executed = 20, 10
     policy = ACTHandRelativePolicy(_config(chunk_size=chunk, n_action_steps=executed), dataset_stats=stats,
-                                   dataset_meta=SimpleNamespace(root=root, fps=20))
+                                   dataset_meta=SimpleNamespace(root=demonstration.root, fps=20))
     policy.save_pretrained(tmp_path / "checkpoint")
     for pipeline in make_pre_post_processors(policy.config, dataset_stats=stats):
         pipeline.save_pretrained(tmp_path / "checkpoint")
@@ -296,17 +281,5 @@ def test_chunks_planned_on_recorded_states_land_on_the_recorded_actions_when_anc
 
     planned = []
     monkeypatch.setattr(ACTPolicy, "predict_action_chunk", oracle)
-    driver = PolicyDriver(tmp_path / "checkpoint")
-    env = TavisEnv("conditional_pick", "gr1t2", camera_mode="head_only", image_size=(32, 32))
-    observation, _ = env.reset(seed=entry["seed"])
-    driver.reset()
-    errors_m, success = [], False
-    for step in range(len(actions) + 20):  # the last action held for one second more
-        action = driver.act(observation, env.task_description)
-        recorded = actions[min(step, len(actions) - 1)].numpy()
-        errors_m.append(max(np.linalg.norm(action[arm.position] - recorded[arm.position]) for arm in canonical.ARMS))
-        observation, _, success, _, _ = env.step(action)
-        if success:
-            break
-    env.close()
-    assert success and max(errors_m) < 0.015, (success, max(errors_m))  # verify-dataset's replay tolerance
+    success, error_m = replay(tmp_path / "checkpoint", demonstration)
+    assert success and error_m < 0.015, (success, error_m)  # verify-dataset's replay tolerance

@@ -20,7 +20,7 @@ from lerobot_tavis.policies.diffusion_hand_relative.modeling_diffusion_hand_rela
     DiffusionHandRelativePolicy,
 )
 from lerobot_tavis.policies.hand_frame import to_hand_frame
-from tests.policies.conftest import made_up_episode
+from tests.policies.conftest import made_up_episode, replay
 
 OBS, HORIZON, EXECUTED = 2, 8, 4
 IMAGE = "observation.images.head"
@@ -196,3 +196,38 @@ def test_a_checkpoint_keeps_the_statistics_and_lerobot_finds_the_policy_and_its_
     torch.testing.assert_close(processed[OBS_STATE], raw_state)  # the anchor reaches the policy un-normalised
     torch.testing.assert_close(postprocessor(torch.zeros(1, 19)),
                                ((policy.absolute_min + policy.absolute_max) / 2).unsqueeze(0))
+
+
+def test_horizons_planned_on_recorded_states_land_on_the_recorded_actions_when_anchored_on_the_env(demonstration,
+                                                                                                   tmp_path,
+                                                                                                   monkeypatch):
+    """The anchor a policy learns on (the dataset's current observation.state) is the one it acts on (the env's
+    agent_pos, which the checkpoint's processors leave raw), and the executed actions are the horizon's from the
+    current step on: an oracle network that plans every horizon from the recorded actions and states, executed by a
+    checkpoint in `PolicyDriver`, repeats the demonstration."""
+    from lerobot.policies.factory import make_pre_post_processors
+
+    actions, states = demonstration.actions, demonstration.states
+    stats = {key: {"min": values.min(0).values.numpy(), "max": values.max(0).values.numpy()}
+             for key, values in ((ACTION, actions), (OBS_STATE, states))}
+    stats[IMAGE] = {"mean": np.full((3, 1, 1), 0.5), "std": np.full((3, 1, 1), 0.25)}
+    horizon, executed = 16, 8
+    policy = DiffusionHandRelativePolicy(
+        _config(horizon=horizon, n_action_steps=executed, inputs={
+            IMAGE: PolicyFeature(FeatureType.VISUAL, (3, 32, 32)), OBS_STATE: PolicyFeature(FeatureType.STATE, (19,))}),
+        dataset_stats=stats, dataset_meta=SimpleNamespace(root=demonstration.root, fps=20))
+    policy.save_pretrained(tmp_path / "checkpoint")
+    for pipeline in make_pre_post_processors(policy.config, dataset_stats=stats):
+        pipeline.save_pretrained(tmp_path / "checkpoint")
+
+    def oracle(self, batch, noise=None):  # the horizon the demonstrator executed, from the step before this one
+        start = len(planned) * executed
+        planned.append(start)
+        indices = torch.clamp(torch.arange(start - (OBS - 1), start - (OBS - 1) + horizon), 0, len(actions) - 1)
+        relative = to_hand_frame(actions[indices].unsqueeze(0), states[start].unsqueeze(0))
+        return _min_max(relative, policy.relative_min, policy.relative_max)[:, OBS - 1:OBS - 1 + executed]
+
+    planned = []
+    monkeypatch.setattr(DiffusionModel, "generate_actions", oracle)
+    success, error_m = replay(tmp_path / "checkpoint", demonstration)
+    assert success and error_m < 0.015, (success, error_m)  # verify-dataset's replay tolerance
