@@ -146,3 +146,20 @@ def test_add_entry_waits_for_another_writer_of_the_file(tmp_path):
     writer.join()
     assert time.monotonic() - started >= 0.3  # it waited for the lock instead of failing
     assert [e["results"] for e in json.loads(baselines.read_text())] == ["cell/results.json"]
+
+
+def test_the_ablation_pairs_the_head_policies_and_shows_the_hands_policy_beside_them(tmp_path):
+    import shutil
+
+    entries = [entry for entry in read_entries(REPO / BASELINES_PATH, REPO) if entry.task == "clutter_pick_cube"]
+    for entry in entries:
+        shutil.copytree((REPO / entry.results).parent, (tmp_path / entry.results).parent)
+    blocked = _results(tmp_path, "blocked", "gr1t2", "head_wrist", ("blocked_clutter_pick_cube", "id", 48, 96, 0.4))
+    entries.append(_entry("gr1t2", "blocked_clutter_pick_cube", "head_wrist", blocked))
+    text = ablation_markdown(entries, tmp_path, "gr1t2")
+    assert ("| Hands policy, head camera black (wrists alone) | blocked_clutter_pick_cube | head_wrist "
+            "| 50.0% [40.2, 59.8] |") in text
+    assert text.count("not paired: the tasks' episodes differ") == 2
+    assert "only A 46, only B 10; exact McNemar p < 0.001" in text
+    assert "not run" not in text
+    assert ablation_markdown(entries, tmp_path, "reachy2").count("not run") == 6  # 3 cells, 3 pairs
