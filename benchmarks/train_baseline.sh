@@ -32,8 +32,9 @@
 # `--policy.optimizer_lr_backbone`),
 # GPUS (1; N > 1, not with `pair`: `train` runs lerobot-train data-parallel in N processes of `accelerate launch`,
 # one per visible GPU, each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS
-# and SAVE_FREQ by N for the one-GPU budget, which ACTIONS=hand_relative does itself), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
-# and reads the frames from it, TAVIS_FRAME_CACHE=1; docs/training.md, "Training at scale"),
+# and SAVE_FREQ by N for the one-GPU budget, which ACTIONS=hand_relative does itself), FRAME_CACHE (off; on: `train`
+# writes the dataset's frame cache once, `tavis cache-frames`, and reads the frames from it, TAVIS_FRAME_CACHE=1;
+# docs/training.md, "Training at scale"),
 # WORK (/tmp/tavis_baseline).
 #
 # - pair: both conditions of TASK at once from one recording, each a `cell` with half the cores, each on its own
