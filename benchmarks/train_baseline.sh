@@ -37,8 +37,9 @@
 # datasets with the ACT runs: RUN below is diffusion_<CONDITION>, else <CONDITION>),
 # GPUS (1; N > 1, not with `pair`: `train` runs lerobot-train data-parallel in N processes of `accelerate launch`,
 # one per visible GPU, each with BATCH and WORKERS / N loader workers, so a step trains N x BATCH samples: divide STEPS
-# and SAVE_FREQ by N for the one-GPU budget, which ACTIONS=hand_relative does itself), FRAME_CACHE (off; on: `train` writes the dataset's frame cache once, `tavis cache-frames`,
-# and reads the frames from it, TAVIS_FRAME_CACHE=1; docs/training.md, "Training at scale"),
+# and SAVE_FREQ by N for the one-GPU budget, which ACTIONS=hand_relative does itself), FRAME_CACHE (off; on: `train`
+# writes the dataset's frame cache once, `tavis cache-frames`, and reads the frames from it, TAVIS_FRAME_CACHE=1;
+# docs/training.md, "Training at scale"),
 # SPLITS (id: the splits each evaluation plays, comma-separated; table: id for fixed_wrist and id, ood_spatial and
 # ood_init_pose for head_wrist, the baselines table's protocol), DEVICE (cuda; cpu: training and evaluation without
 # a GPU and without AMP, for tiny runs that test the pipeline), VIDEO_BACKEND (how training decodes the dataset's

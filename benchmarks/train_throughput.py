@@ -21,9 +21,9 @@ preset as it ships) at each batch per GPU of `--batch` (default: the setting's) 
 process per GPU: `accelerate launch --multi_gpu` for more than one) with each frame source of `--cache` (off: decoded
 from the videos; uint8: the frame cache, `TAVIS_FRAME_CACHE=1`, frames as uint8 to the GPU; float32: the cache with
 the loader workers converting to float32, `TAVIS_FRAME_CACHE=float32`), `--steps` steps each. Per run it keeps
-LeRobot's samples/s (median after the first `--warm-up` steps: worker start, cudnn autotuning, the loader's
-prefetched batches), the wall-clock samples/s (samples trained between the first log line after the warm-up and the
-last, over the time between them), update and data-wait time per step, each GPU's mean utilisation over that window
+LeRobot's samples/s (median after the first `--warm-up` steps: worker start, cudnn autotuning), the wall-clock
+samples/s (samples trained between the first log line after the warm-up and the last, over the time between them),
+update and data-wait time per step, each GPU's mean utilisation over that window
 (nvidia-smi's `utilization.gpu`, the share of time a kernel was running, sampled every 0.5 s) and the minutes
 `--budget` samples take at the wall-clock rate. `--device cpu` runs the same grid on CPU processes (no AMP, no
 utilisation) to check the command before GPU time is spent. Each run's result is saved as it ends
@@ -302,8 +302,9 @@ def write_scale_report(work: Path, budget: int, episodes: int) -> None:
              f"{episodes} demonstrations at {SCALE_IMAGE_SIZE})"
              f"{'; CPU processes in place of GPUs: a check of the command, not a measurement' if on_cpu else ''}.",
              "",
-             f"| setting | GPUs | frames | batch per GPU | samples/s (wall) | x decoded, 1 GPU | samples/s (LeRobot log) "
-             f"| GPU utilisation % (mean; lowest GPU) | update s/step | data wait s/step | min to {budget:,} samples |",
+             "| setting | GPUs | frames | batch per GPU | samples/s (wall) | x decoded, 1 GPU "
+             f"| samples/s (LeRobot log) | GPU utilisation % (mean; lowest GPU) | update s/step | data wait s/step "
+             f"| min to {budget:,} samples |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for run in runs:
         frames = FRAMES_LABEL[run["cache"]].format(backend=run["video_backend"])

@@ -37,12 +37,10 @@ def test_where_lerobot_policies_are_loaded_the_plugin_registers_the_policy_types
 
 
 def test_where_lerobots_dataset_factory_is_loaded_the_switch_points_it_at_the_frame_cache():
-    """lerobot-train loads the factory before its plugins; TAVIS_FRAME_CACHE=1 (or float32) swaps its dataset class,
-    else not."""
+    """lerobot-train loads the factory before its plugins; TAVIS_FRAME_CACHE=1 swaps its dataset class, else not."""
     code = ("import lerobot.datasets.factory as factory, lerobot_env_tavis; "
             "print(factory.LeRobotDataset.__module__, factory.LeRobotDataset.__name__)")
     for switch, expected in (("1", "lerobot_tavis.dataset_tools.cached_dataset TrainingFrameCachedDataset"),
-                             ("float32", "lerobot_tavis.dataset_tools.cached_dataset TrainingFloatFrameCachedDataset"),
                              ("0", "lerobot.datasets.lerobot_dataset LeRobotDataset")):
         out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True,
                              env={**os.environ, "TAVIS_FRAME_CACHE": switch}).stdout

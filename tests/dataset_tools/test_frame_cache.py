@@ -115,6 +115,19 @@ def test_the_preprocessed_batch_is_the_same_from_uint8_float32_and_decoded_frame
                 assert got[key].dtype == value.dtype and torch.equal(got[key], value), (name, key)
 
 
+def test_the_switch_picks_the_dataset_class_of_lerobots_factory(monkeypatch):
+    """TAVIS_FRAME_CACHE=1 reads frames as lerobot-train asks for them (uint8); float32 converts in the workers."""
+    import lerobot.datasets.factory as factory
+
+    from lerobot_tavis.dataset_tools import cached_dataset
+
+    monkeypatch.setattr(factory, "LeRobotDataset", factory.LeRobotDataset)  # restored after the test
+    for mode, expected in (("1", cached_dataset.TrainingFrameCachedDataset),
+                           ("float32", cached_dataset.TrainingFloatFrameCachedDataset)):
+        cached_dataset.use_frame_cache(mode)
+        assert factory.LeRobotDataset is expected
+
+
 def test_a_cache_of_an_earlier_state_of_the_dataset_is_refused_in_one_line(dataset_root, tmp_path, capsys):
     copy = shutil.copytree(dataset_root, tmp_path / "dataset")
     with pytest.raises(StaleFrameCacheError, match="no frame cache for .*; run `tavis cache-frames"):
