@@ -110,7 +110,7 @@ def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float,
 
 def main() -> None:
     from lerobot_tavis.dataset_tools.raw import Manifest, load_episode
-    from lerobot_tavis.dataset_tools.workers import executor
+    from lerobot_tavis.workers import executor
     from lerobot_tavis.envs.transforms import axis_angle_quat
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])

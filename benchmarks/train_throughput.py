@@ -294,7 +294,7 @@ def write_scale_report(work: Path, budget: int, episodes: int) -> None:
 
 def main() -> None:
     from lerobot_tavis.dataset_tools.quiet import video_backend
-    from lerobot_tavis.dataset_tools.workers import usable_cores
+    from lerobot_tavis.workers import usable_cores
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("stage", choices=["data", "train", "scale"])

@@ -22,7 +22,7 @@ from tqdm import tqdm
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
-from lerobot_tavis.dataset_tools.workers import BACKENDS, executor
+from lerobot_tavis.workers import BACKENDS, executor
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import SUITES, expand_tasks, split_names
 from lerobot_tavis.errors import FieldError, InputError

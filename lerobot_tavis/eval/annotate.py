@@ -17,7 +17,7 @@ from concurrent.futures import Future
 from pathlib import Path
 
 from lerobot_tavis.atomic import write_bytes
-from lerobot_tavis.dataset_tools.workers import executor
+from lerobot_tavis.workers import executor
 from lerobot_tavis.envs.physics import POLICY_HZ
 from lerobot_tavis.eval.report import join
 from lerobot_tavis.media import encode_mp4, iter_mp4

@@ -1,6 +1,6 @@
 """Protocol cells as (cell, task, seed chunk) jobs spread over every worker, for the demonstrators and policies.
 
-All chunks of all pending cells go to one pool (`dataset_tools.workers`: local processes or Ray), so every core,
+All chunks of all pending cells go to one pool (`workers`: local processes or Ray), so every core,
 or every share of a GPU, stays busy whatever the number of tasks. A chunk's outcome depends only on its task,
 split and seeds (a policy chunk is one lerobot-eval run seeded with its first seed), each chunk's results come back
 to this process, and each cell is assembled in a fixed order (task, then seed) once its last chunk is done: the
@@ -35,8 +35,8 @@ from pathlib import Path
 from tqdm import tqdm
 
 from lerobot_tavis.atomic import write_text
-from lerobot_tavis.dataset_tools.staging import staged_directory
-from lerobot_tavis.dataset_tools.workers import executor, usable_cores
+from lerobot_tavis.staging import staged_directory
+from lerobot_tavis.workers import executor, usable_cores
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.annotate import ANNOTATED_DIR, Annotator, episode_index

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from lerobot_tavis import checks
 from lerobot_tavis.cli_options import option, spelling
-from lerobot_tavis.dataset_tools.workers import BACKENDS
+from lerobot_tavis.workers import BACKENDS
 from lerobot_tavis.envs.checkpoint_settings import (CheckpointSettings, match_settings, pretrained_model_dir,
                                                     read_checkpoint_settings)
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, RENAMED_MODES, camera_mode_names, resolve_camera_mode

@@ -406,7 +406,7 @@ def write_report(root: str | Path, workers: int | None = None) -> list[Path]:
     """Build the report of every evaluation under `root` and write it there, with an annotated copy of each
     episode video (`lerobot_tavis.eval.annotate`, `workers` processes: default every core this process may use);
     returns the written files."""
-    from lerobot_tavis.dataset_tools.workers import usable_cores
+    from lerobot_tavis.workers import usable_cores
     from lerobot_tavis.eval.annotate import annotate_videos
 
     root = Path(root)

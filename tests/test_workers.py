@@ -4,7 +4,7 @@ import os
 
 import pytest
 
-from lerobot_tavis.dataset_tools.workers import InlineExecutor, executor
+from lerobot_tavis.workers import InlineExecutor, executor
 from lerobot_tavis.errors import FieldError
 
 
