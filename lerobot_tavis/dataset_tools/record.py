@@ -22,11 +22,11 @@ from tqdm import tqdm
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
-from lerobot_tavis.workers import BACKENDS, executor
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import SUITES, expand_tasks, split_names
 from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.locking import exclusive_output
+from lerobot_tavis.workers import BACKENDS, executor
 
 RECORD_FPS = 60
 

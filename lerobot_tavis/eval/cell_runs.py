@@ -35,15 +35,15 @@ from pathlib import Path
 from tqdm import tqdm
 
 from lerobot_tavis.atomic import write_text
-from lerobot_tavis.staging import staged_directory
-from lerobot_tavis.workers import executor, usable_cores
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.annotate import ANNOTATED_DIR, Annotator, episode_index
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
-from lerobot_tavis.eval.report import EVAL_INFO_NAME
+from lerobot_tavis.eval.outputs import EVAL_INFO_NAME
 from lerobot_tavis.eval.run_identity import RUN_FIELD, RUN_FILE
 from lerobot_tavis.policies import register_policy_types
+from lerobot_tavis.staging import staged_directory
+from lerobot_tavis.workers import executor, usable_cores
 
 METRICS = ("successes", "sum_rewards", "max_rewards")  # per-episode lists of lerobot-eval's per-task metrics
 ENV_WORKER_NICENESS = 10  # env workers yield contended cores to the policy's process, use idle ones; same outcomes

@@ -18,9 +18,9 @@ from pathlib import Path
 import pytest
 
 from lerobot_tavis.atomic import NAME_MAX_BYTES, write_text
-from lerobot_tavis.staging import staged_directory
 from lerobot_tavis.errors import PathExistsError
 from lerobot_tavis.eval.report import build_report
+from lerobot_tavis.staging import staged_directory
 from tests.eval.test_report import _eval_dir
 
 EXPERT_EVAL = ["eval", "--expert", "--tasks", "conditional_pick", "--splits", "id", "--episode-length-s", "0.5"]
