@@ -140,7 +140,7 @@ _ENVS: dict[tuple, object] = {}  # per process: the last chunk's (task, split) -
 def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
     """Play one chunk with the demonstrators (in a worker)."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from lerobot_tavis.envs.factory import make_tavis_env
+    from lerobot_tavis.eval.env_factory import make_tavis_env
     from lerobot_tavis.eval.episode_log import EpisodeLogger
     from lerobot_tavis.experts.registry import run_episode
 
@@ -183,7 +183,7 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
     worker)."""
     from lerobot.configs.default import EvalConfig
 
-    from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
     from lerobot_tavis.eval.lerobot_run import evaluate, pipeline_config
 
     if cfg.device != "cpu":

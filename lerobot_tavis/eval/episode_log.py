@@ -21,11 +21,10 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from lerobot_tavis.envs.factory import EPISODE_LOG_NAME
 from lerobot_tavis.metrics.episode_metric import Episode
 from lerobot_tavis.metrics.registry import episode_metrics
 
-__all__ = ["EPISODE_LOG_NAME", "EpisodeLogger", "metric_fields"]
+EPISODE_LOG_NAME = "episodes.jsonl"  # the episode log's file name in an evaluation's output directory
 
 
 def metric_fields(episode: Episode) -> dict:
