@@ -19,7 +19,7 @@ from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_NAMES
 from lerobot_tavis.envs.robots import robot_names
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_info
-from lerobot_tavis.experts.registry import make_expert
+from lerobot_tavis.experts.rollout import make_expert
 from lerobot_tavis.media import write_mp4
 from lerobot_tavis.metrics.galt import compute_galt
 from lerobot_tavis.overlay import Caption, EpisodeEvents, redraw_caption

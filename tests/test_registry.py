@@ -23,7 +23,7 @@ from lerobot_tavis.envs.robots.gr1t2 import GR1T2
 from lerobot_tavis.envs.tasks.base import TargetFacts, Task, lift_conditions
 from lerobot_tavis.envs.tasks.catalog import expand_tasks
 from lerobot_tavis.experts.base import Expert, Hold, Move, Segment
-from lerobot_tavis.experts.registry import make_expert, run_episode
+from lerobot_tavis.experts.rollout import make_expert, run_episode
 
 # -- a toy task: the red cube on the table, lift it ---------------------------------------------------------------
 TOY_TASK = registry.TaskInfo(

@@ -166,7 +166,7 @@ def record_episode(robot: str, task: str, split: str, seed: int,
                    keep_failures: bool) -> tuple[ManifestEntry, RawEpisode | None]:
     """Play one demonstrator episode at 60 Hz; returns its manifest entry and, if kept, the episode (the calling
     process writes it). Runs in a worker."""
-    from lerobot_tavis.experts.registry import run_episode
+    from lerobot_tavis.experts.rollout import run_episode
 
     env = _env(robot, task, split)
     states = StateLog()

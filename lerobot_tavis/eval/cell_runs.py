@@ -142,7 +142,7 @@ def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
     os.environ.setdefault("MUJOCO_GL", "egl")
     from lerobot_tavis.eval.env_factory import make_tavis_env
     from lerobot_tavis.eval.episode_log import EpisodeLogger
-    from lerobot_tavis.experts.registry import run_episode
+    from lerobot_tavis.experts.rollout import run_episode
 
     key = (chunk.task, chunk.split)
     if key not in _ENVS:

@@ -2,7 +2,7 @@
 
 Every `eval_info.json` under the directory (LeRobot's result of one lerobot-eval run) is joined with the
 `episodes.jsonl` next to it (`eval.outputs.join`: exactly the episodes LeRobot scored). Every metric of
-`lerobot_tavis.metrics.registry` (GALT, the wrist lead) is summarised per cell from its `<name>_s` and
+`lerobot_tavis.metrics.logged_metrics` (GALT, the wrist lead) is summarised per cell from its `<name>_s` and
 `<name>_reason` fields, in registry order, and the failed episodes logged with `reach` are counted by how far they
 got (`lerobot_tavis.envs.reach.failure_stage`). Writes `results.json`, `results.md`, `success_rates.png` and
 `<metric>_<task>.png` (metrics with a histogram, e.g. `galt_<task>.png`) into the directory, and beside each
@@ -25,7 +25,7 @@ from lerobot_tavis.errors import InputError
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.eval.outputs import eval_dirs, join
 from lerobot_tavis.eval.run_identity import EPISODE_FIELDS, RUN_FIELD, differences
-from lerobot_tavis.metrics.registry import episode_metrics
+from lerobot_tavis.metrics.logged_metrics import episode_metrics
 from lerobot_tavis.metrics.stats import wilson_interval
 
 DELTA_SPLITS = ("ood_spatial", "ood_visual")  # the report gives id minus each, per task
