@@ -213,7 +213,7 @@ def _push(options: PushOptions) -> None:
 
 
 def _push_policy(options: PushPolicyOptions) -> None:
-    from lerobot_tavis.policies.hub import push_policy
+    from lerobot_tavis.policy_hub import push_policy
 
     print(push_policy(options.checkpoint, options.repo_id, results=options.results, private=options.private,
                       branch=options.branch))
