@@ -106,3 +106,17 @@ def test_the_checks_find_an_upward_import_inside_a_function_and_a_loop(tmp_path)
     assert upward_imports(graph) == ["lerobot_tavis.envs.env (simulation) imports lerobot_tavis.eval.report "
                                      "(evaluation)"]
     assert loops(graph) == ["lerobot_tavis.eval.report -> lerobot_tavis.eval.annotate -> lerobot_tavis.eval.report"]
+
+
+def test_the_docs_table_of_layers_lists_these_layers_and_modules():
+    """docs/extending.md shows the layers as a table; its rows are LAYERS, in order ("the package itself" is
+    `lerobot_tavis`, a name without package is under `lerobot_tavis/`)."""
+    text = (ROOT / "docs" / "extending.md").read_text()
+    table = text[text.index("| layer | modules"):].split("\n\n")[0].splitlines()[2:]
+    rows = []
+    for row in table:
+        layer, modules = (cell.strip() for cell in row.strip("|").split("|")[:2])
+        names = [name.rstrip("/") for name in modules.split("`")[1::2]]
+        names = [name if name.startswith("lerobot_env_tavis") else f"lerobot_tavis.{name}" for name in names]
+        rows.append((layer, tuple(sorted(names + ["lerobot_tavis"] * ("the package itself" in modules)))))
+    assert rows == [(layer, tuple(sorted(names))) for layer, names in LAYERS]
