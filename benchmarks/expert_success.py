@@ -23,8 +23,8 @@ def run_chunk(args: tuple[str, str, str, range]) -> tuple[str, str, str, int, in
     task, robot, split, seeds = args
     os.environ.setdefault("MUJOCO_GL", "egl")
     from lerobot_tavis.envs.env import TavisEnv
-    from lerobot_tavis.experts.registry import run_episode
     from lerobot_tavis.envs.tasks.catalog import task_info
+    from lerobot_tavis.experts.rollout import run_episode
     from lerobot_tavis.metrics.galt import compute_galt, wrist_lead_per_grasp
 
     def lead_s(actions) -> float | None:

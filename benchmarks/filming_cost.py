@@ -22,7 +22,7 @@ def small_act_checkpoint(path: Path) -> None:
     from lerobot.policies.act.configuration_act import ACTConfig
     from lerobot.policies.factory import make_policy, make_pre_post_processors
 
-    from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
 
     config = ACTConfig(pretrained_backbone_weights=None, device="cpu", push_to_hub=False, dim_model=64,
                        n_encoder_layers=1, n_decoder_layers=1, dim_feedforward=128, chunk_size=20, n_action_steps=10)

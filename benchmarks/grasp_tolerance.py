@@ -110,8 +110,8 @@ def replay_shifted(path: str, shifts_m: list[np.ndarray], hold_s: float,
 
 def main() -> None:
     from lerobot_tavis.dataset_tools.raw import Manifest, load_episode
-    from lerobot_tavis.dataset_tools.workers import executor
     from lerobot_tavis.envs.transforms import axis_angle_quat
+    from lerobot_tavis.workers import executor
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--raw", required=True, help="a `tavis record` directory")

@@ -17,7 +17,7 @@ def table_contacts(task: str, robot: str, seeds: range) -> tuple[int, int, int, 
     """Successes, steps, steps with a robot-table contact, the deepest contact (m) and the robot geoms touching."""
     os.environ.setdefault("MUJOCO_GL", "egl")
     from lerobot_tavis.envs.env import TavisEnv
-    from lerobot_tavis.experts.registry import run_episode
+    from lerobot_tavis.experts.rollout import run_episode
 
     env = TavisEnv(task, robot, camera_mode="head_only", split="id", cameras=())
     env.reset(seed=seeds[0])  # builds the model

@@ -323,7 +323,7 @@ def write_scale_report(work: Path, budget: int, episodes: int) -> None:
 
 def main() -> None:
     from lerobot_tavis.dataset_tools.quiet import video_backend
-    from lerobot_tavis.dataset_tools.workers import usable_cores
+    from lerobot_tavis.workers import usable_cores
     from lerobot_tavis.errors import InputError
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -27,7 +27,7 @@ def measure(task: str, robot: str, render: bool) -> dict:
     start = time.perf_counter()
     from lerobot_tavis.envs.env import TavisEnv
     import_s = time.perf_counter() - start
-    from lerobot_tavis.experts.registry import run_episode
+    from lerobot_tavis.experts.rollout import run_episode
 
     env = TavisEnv(task, robot, camera_mode="head_wrist", image_size=(96, 128), cameras=None if render else ())
     result = run_episode(env, seed=0)

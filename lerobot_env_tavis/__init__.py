@@ -9,7 +9,7 @@ frame cache (`lerobot_tavis.dataset_tools.cached_dataset`)."""
 import sys
 
 from lerobot_tavis.dataset_tools.quiet import shorten_torchcodec_fallback
-from lerobot_tavis.envs.config import TavisEnvConfig
+from lerobot_tavis.eval.env_config import TavisEnvConfig
 from lerobot_tavis.lerobot_cli_errors import report_env_field_errors
 
 shorten_torchcodec_fallback()

@@ -1,6 +1,6 @@
 """Files written whole or not at all: the content goes to a dot-named partial file beside the destination and is
 renamed onto it when complete, so a reader sees the old file or the new one, never half of one; a failure removes
-the partial file. (Whole directories are staged by `dataset_tools.staging`.)"""
+the partial file. (Whole directories are staged by `staging`.)"""
 
 from __future__ import annotations
 

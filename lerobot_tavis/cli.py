@@ -1,15 +1,16 @@
 """The `tavis` command. Each subcommand's options are one dataclass, its parser generated from it (`cli_options`):
-the config of the package module the subcommand runs where it has one, else one below. Heavy imports happen inside
-the subcommands."""
+the config of the package module the subcommand runs where it has one, else one below. `build_parser` lists every
+subcommand with the function that imports its module (a plain import, run only when that subcommand is parsed, so
+`tavis --help` loads none of them) and returns its options dataclass and the function that runs it."""
 
 from __future__ import annotations
 
 import argparse
-import importlib
 import os
 import signal
 import sys
 import threading
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -96,16 +97,71 @@ class CompareOptions:
     eval_b: Path = option(help="another one, evaluated on the same seeds", positional=True)
 
 
-def _printing(target: str):
-    """A subcommand's run: call `target` ("module:function", imported only when the subcommand runs) with the
-    options and print each line it returns (written files, messages)."""
-    module, _, name = target.partition(":")
+def _printing(run: Callable[..., Iterable]) -> Callable[..., None]:
+    """A subcommand's run: call `run` with the options and print each line it returns (written files, messages)."""
 
-    def run(cfg) -> None:
-        for line in getattr(importlib.import_module(module), name)(cfg):
+    def printed(cfg) -> None:
+        for line in run(cfg):
             print(line)
 
-    return run
+    return printed
+
+
+def _at_hand(options: type, run: Callable[..., None]) -> Callable[[], tuple[type, Callable[..., None]]]:
+    """A subcommand whose options dataclass is in this module; its run imports what it needs."""
+    return lambda: (options, run)
+
+
+def _demo_command():
+    from lerobot_tavis.demo import DemoConfig, run_demo
+
+    return DemoConfig, _printing(run_demo)
+
+
+def _gallery_command():
+    from lerobot_tavis.gallery import GalleryConfig, write_gallery
+
+    return GalleryConfig, _printing(write_gallery)
+
+
+def _eval_command():
+    from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
+
+    return ProtocolConfig, _printing(run_protocol)
+
+
+def _record_command():
+    from lerobot_tavis.dataset_tools.record import RecordConfig, record
+
+    def run(cfg: RecordConfig) -> None:
+        for task, count in record(cfg).counts().items():
+            print(f"{task}: {count['kept']} kept, {count['discarded']} discarded")
+
+    return RecordConfig, run
+
+
+def _teleop_command():
+    from lerobot_tavis.teleop import TeleopConfig, teleop
+
+    return TeleopConfig, _printing(teleop)
+
+
+def _view_command():
+    from lerobot_tavis.viewer import ViewConfig, view
+
+    return ViewConfig, view
+
+
+def _convert_command():
+    from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+
+    return ConvertConfig, lambda cfg: print(convert(cfg))
+
+
+def _cache_frames_command():
+    from lerobot_tavis.dataset_tools.frame_cache import CacheFramesConfig, write_frame_cache
+
+    return CacheFramesConfig, _printing(write_frame_cache)
 
 
 def _report(options: ReportOptions) -> None:
@@ -122,23 +178,11 @@ def _curve(options: CurveOptions) -> None:
         print(path)
 
 
-def _record(cfg) -> None:
-    from lerobot_tavis.dataset_tools.record import record
+def _compare(options: CompareOptions) -> None:
+    from lerobot_tavis.eval.compare import run_compare
 
-    for task, count in record(cfg).counts().items():
-        print(f"{task}: {count['kept']} kept, {count['discarded']} discarded")
-
-
-def _view(cfg) -> None:
-    from lerobot_tavis.viewer import view
-
-    view(cfg)
-
-
-def _convert(cfg) -> None:
-    from lerobot_tavis.dataset_tools.convert import convert
-
-    print(convert(cfg))
+    for line in run_compare(options):
+        print(line)
 
 
 def _verify_dataset(options: VerifyOptions) -> None:
@@ -172,7 +216,7 @@ def _push(options: PushOptions) -> None:
 
 
 def _push_policy(options: PushPolicyOptions) -> None:
-    from lerobot_tavis.policies.hub import push_policy
+    from lerobot_tavis.policy_hub import push_policy
 
     print(push_policy(options.checkpoint, options.repo_id, results=options.results, private=options.private,
                       branch=options.branch, out=options.out))
@@ -253,45 +297,40 @@ def _check_dataset_root(preset: Path, lerobot_args: tuple[str, ...]) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The `tavis` parser: one subcommand per (name, options dataclass, run function, help) below."""
+    """The `tavis` parser: one subcommand per (name, command, help) below, where `command()` imports the
+    subcommand's module and returns its options dataclass and run function."""
     parser = argparse.ArgumentParser(prog="tavis", description="TAVIS active-vision benchmark in MuJoCo")
     parser.add_argument("--version", action="version", version=version_line())
     commands = parser.add_subparsers(dest="command", required=True, parser_class=CommandParser)
-    for name, options, run, help in (
-        ("demo", "lerobot_tavis.demo:DemoConfig", _printing("lerobot_tavis.demo:run_demo"),
-         "one demonstrator episode per task and robot: MP4 of the four views"),
-        ("gallery", "lerobot_tavis.gallery:GalleryConfig", _printing("lerobot_tavis.gallery:write_gallery"),
+    for name, command, help in (
+        ("demo", _demo_command, "one demonstrator episode per task and robot: MP4 of the four views"),
+        ("gallery", _gallery_command,
          "stills of every task and robot (first observation, grasp) and the README overview figure"),
-        ("eval", "lerobot_tavis.eval.protocol:ProtocolConfig", _printing("lerobot_tavis.eval.protocol:run_protocol"),
-         "the 96-episode protocol for a policy checkpoint or the demonstrators"),
-        ("record", "lerobot_tavis.dataset_tools.record:RecordConfig", _record,
-         "record scripted demonstrations at 60 Hz (replayable raw episodes)"),
-        ("teleop", "lerobot_tavis.teleop:TeleopConfig", _printing("lerobot_tavis.teleop:teleop"),
-         "drive the robot with the keyboard and record raw episodes (a window)"),
-        ("view", "lerobot_tavis.viewer:ViewConfig", _view, "MuJoCo's interactive viewer on one episode (a window)"),
-        ("convert", "lerobot_tavis.dataset_tools.convert:ConvertConfig", _convert,
-         "raw episodes (or an original TAVIS dataset) -> LeRobotDataset v3.0"),
-        ("cache-frames", "lerobot_tavis.dataset_tools.frame_cache:CacheFramesConfig",
-         _printing("lerobot_tavis.dataset_tools.frame_cache:write_frame_cache"),
+        ("eval", _eval_command, "the 96-episode protocol for a policy checkpoint or the demonstrators"),
+        ("record", _record_command, "record scripted demonstrations at 60 Hz (replayable raw episodes)"),
+        ("teleop", _teleop_command, "drive the robot with the keyboard and record raw episodes (a window)"),
+        ("view", _view_command, "MuJoCo's interactive viewer on one episode (a window)"),
+        ("convert", _convert_command, "raw episodes (or an original TAVIS dataset) -> LeRobotDataset v3.0"),
+        ("cache-frames", _cache_frames_command,
          "decode a dataset's video frames once into a cache beside it, for lerobot-train with TAVIS_FRAME_CACHE=1"),
-        ("verify-dataset", VerifyOptions, _verify_dataset,
+        ("verify-dataset", _at_hand(VerifyOptions, _verify_dataset),
          "replay a converted dataset's actions open loop and check they reproduce its recorded states (exit 1 if "
          "not)"),
-        ("noise-state", NoiseStateOptions, _noise_state,
+        ("noise-state", _at_hand(NoiseStateOptions, _noise_state),
          "copy a dataset with Gaussian noise on the hand poses of observation.state (a training augmentation)"),
-        ("push", PushOptions, _push, "upload a converted dataset to the Hugging Face Hub, with its card"),
-        ("push-policy", PushPolicyOptions, _push_policy,
+        ("push", _at_hand(PushOptions, _push), "upload a converted dataset to the Hugging Face Hub, with its card"),
+        ("push-policy", _at_hand(PushPolicyOptions, _push_policy),
          "upload a trained policy checkpoint to the Hugging Face Hub, with a model card (and its results)"),
-        ("pull", PullOptions, _pull, "download a TAVIS dataset from the Hugging Face Hub"),
-        ("presets", PresetsOptions, _presets, "list the training presets, or print the path of one"),
-        ("train", TrainOptions, _train,
+        ("pull", _at_hand(PullOptions, _pull), "download a TAVIS dataset from the Hugging Face Hub"),
+        ("presets", _at_hand(PresetsOptions, _presets), "list the training presets, or print the path of one"),
+        ("train", _at_hand(TrainOptions, _train),
          "lerobot-train with a preset (checks the dataset's cameras and image size and pi0 downloads first); extra "
          "arguments go to lerobot-train"),
-        ("report", ReportOptions, _report,
+        ("report", _at_hand(ReportOptions, _report),
          "success rates with Wilson CIs, GALT, failure stages, plots from eval outputs"),
-        ("curve", CurveOptions, _curve,
+        ("curve", _at_hand(CurveOptions, _curve),
          "success by training step from one eval output per checkpoint (step_<N>/): checkpoints.md and .png"),
-        ("compare", CompareOptions, _printing("lerobot_tavis.eval.compare:run_compare"),
+        ("compare", _at_hand(CompareOptions, _compare),
          "two evaluations of the same seeds, episode by episode: successes of each and the exact McNemar test"),
         ("table-add", "lerobot_tavis.eval.baselines:TableAddConfig",
          _printing("lerobot_tavis.eval.baselines:run_table_add"),
@@ -306,7 +345,7 @@ def build_parser() -> argparse.ArgumentParser:
          "the wrist-only ablation (clutter_pick_cube with and without the head camera's active vision against "
          "blocked_clutter_pick_cube) from the baselines table: Wilson CIs and exact McNemar"),
     ):
-        commands.add_parser(name, help=help, options=options).set_defaults(run=run)
+        commands.add_parser(name, help=help, command=command)
     return parser
 
 

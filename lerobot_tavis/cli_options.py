@@ -20,7 +20,6 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from lerobot_tavis import checks
-from lerobot_tavis.importpath import resolve
 
 KEY = "tavis_cli"  # where `option()` keeps its settings in a field's metadata
 
@@ -108,20 +107,22 @@ def from_args(cls: type, args: argparse.Namespace):
 
 
 class CommandParser(argparse.ArgumentParser):
-    """A subcommand's parser whose arguments come from its options dataclass (a class or "module:Class"), added
-    when the subcommand is parsed: `tavis <command>` imports only that command's module, as its run would."""
+    """A subcommand's parser whose arguments come from its options dataclass, added when the subcommand is parsed.
+    `command` imports the subcommand's module and returns (options dataclass, run function): `tavis <command>`
+    imports only that command's module, as its run would."""
 
-    def __init__(self, *args, options: type | str, **kwargs):
+    def __init__(self, *args, command: Callable[[], tuple[type, Callable]], **kwargs):
         super().__init__(*args, **kwargs)
-        self.options = options
+        self.command = command
         self.options_added = False
 
     def load_options(self) -> type:
-        """Add the arguments of the options dataclass (once); returns the dataclass, also parsed as `options`."""
-        options = resolve(self.options)
+        """Add the arguments of the options dataclass (once); returns the dataclass, also parsed as `options`, with
+        the run function as `run`."""
+        options, run = self.command()
         if not self.options_added:
             add_options(self, options)
-            self.set_defaults(options=options)
+            self.set_defaults(options=options, run=run)
             self.options_added = True
         return options
 

@@ -19,7 +19,7 @@ from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_NAMES
 from lerobot_tavis.envs.robots import robot_names
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_info
-from lerobot_tavis.experts.registry import make_expert
+from lerobot_tavis.experts.rollout import make_expert
 from lerobot_tavis.media import write_mp4
 from lerobot_tavis.metrics.galt import compute_galt
 from lerobot_tavis.overlay import Caption, EpisodeEvents, redraw_caption
@@ -42,7 +42,9 @@ def film_episode(task: str, robot: str, image_size: tuple[int, int], seed: int) 
         if terminated or truncated:
             break
     duration_s = len(actions) / env.fps
-    events = EpisodeEvents.from_galt(compute_galt(np.array(actions), fps=env.fps), duration_s if success else None)
+    galt = compute_galt(np.array(actions), fps=env.fps)
+    events = EpisodeEvents(gaze=galt.t_head_arrival_s, reach=galt.t_hand_onset_s, grasp=galt.t_hand_arrival_s,
+                           success=duration_s if success else None)
     frames = [redraw_caption(frame, Caption(env.task_description, step / env.fps, duration_s, events))
               for step, frame in enumerate(frames)]
     frames += frames[-1:] * FPS  # one more second on the final frame

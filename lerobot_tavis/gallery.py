@@ -26,7 +26,7 @@ from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import BUILTIN_ROBOTS, DEFAULT_ROBOT, robot_info, robot_names
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, VISUAL_FACTORS, VISUAL_SPLIT, task_info
-from lerobot_tavis.experts.registry import make_expert
+from lerobot_tavis.experts.rollout import make_expert
 from lerobot_tavis.media import label, write_png
 
 GRASP_DELAY_STEPS = 8  # 0.4 s after the close command: the fingers have met the object

@@ -3,7 +3,7 @@
 The lock is the kernel's (`fcntl.flock`), held by the open file, so it goes with the process that took it, kill -9
 included: no stale lock survives a dead run. The file holds its holder's pid and command line, which a refused run
 quotes, and is removed when the run ends; it lies beside the directory, not in it, because staged outputs replace
-the whole directory when they are complete (`dataset_tools.staging`). Linux and macOS; no heavy imports.
+the whole directory when they are complete (`staging`). Linux and macOS; no heavy imports.
 """
 
 from __future__ import annotations

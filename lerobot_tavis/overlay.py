@@ -26,7 +26,6 @@ import cv2
 import numpy as np
 
 from lerobot_tavis.media import label
-from lerobot_tavis.metrics.galt import GaltResult
 
 PANEL_HEIGHT = 360  # composed panels are this many pixels high whatever the cameras' size: the text stays legible,
 # and a filmed frame stays about 1 MB (lerobot-eval holds every frame of its filmed episodes in memory)
@@ -55,12 +54,6 @@ class EpisodeEvents:
         success = record["length_steps"] / fps if record.get("success") else None
         return cls(gaze=record.get("galt_t_head_arrival_s"), reach=record.get("galt_t_hand_onset_s"),
                    grasp=record.get("galt_t_hand_arrival_s"), success=success)
-
-    @classmethod
-    def from_galt(cls, result: GaltResult, success_s: float | None) -> EpisodeEvents:
-        """The events of a GALT result (`lerobot_tavis.metrics.galt.compute_galt`) and the success time."""
-        return cls(gaze=result.t_head_arrival_s, reach=result.t_hand_onset_s, grasp=result.t_hand_arrival_s,
-                   success=success_s)
 
     def items(self) -> list[tuple[str, float]]:
         return [(name, time) for name, time in vars(self).items() if time is not None]

@@ -188,7 +188,7 @@ def view(cfg: ViewConfig) -> int:
     require_display("tavis view")
     os.environ.setdefault("MUJOCO_GL", "egl")
     from lerobot_tavis.envs.env import TavisEnv
-    from lerobot_tavis.experts.registry import make_expert
+    from lerobot_tavis.experts.rollout import make_expert
 
     if cfg.policy is not None:
         settings = read_checkpoint_settings(pretrained_model_dir(cfg.policy)).known()

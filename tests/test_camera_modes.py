@@ -2,9 +2,9 @@
 
 import pytest
 
-from lerobot_tavis.envs.config import TavisEnvConfig
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.modes import CAMERA_MODES, PAPER_CONDITIONS, resolve_camera_mode
+from lerobot_tavis.eval.env_config import TavisEnvConfig
 from lerobot_tavis.eval.protocol import ENV_DEFAULTS, ProtocolConfig
 from lerobot_tavis.policy_configs import preset_path
 

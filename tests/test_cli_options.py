@@ -92,8 +92,14 @@ def test_a_field_added_to_the_dataclass_appears_on_the_command_line():
 
 
 def test_a_command_parser_adds_its_options_when_first_parsed():
-    parser = CommandParser(prog="toy", options=f"{__name__}:Toy")
-    assert parser.options_added is False
+    loaded = []
+
+    def toy_command():
+        loaded.append(Toy)
+        return Toy, print
+
+    parser = CommandParser(prog="toy", command=toy_command)
+    assert parser.options_added is False and loaded == []
     args = parser.parse_args(["--name", "x"])
-    assert parser.options_added and args.options is Toy
+    assert parser.options_added and args.options is Toy and args.run is print
     assert from_args(args.options, args) == Toy(source=None, name="x")

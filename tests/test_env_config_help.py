@@ -5,10 +5,10 @@ import subprocess
 import sys
 from dataclasses import fields
 
-from lerobot_tavis.envs.config import TavisEnvConfig
 from lerobot_tavis.envs.modes import CAMERA_MODES
 from lerobot_tavis.envs.robots import ROBOTS
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SPLITS, SUITES
+from lerobot_tavis.eval.env_config import TavisEnvConfig
 
 
 def test_every_field_has_help_naming_its_allowed_values():

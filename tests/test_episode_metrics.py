@@ -7,7 +7,7 @@ import pytest
 
 from lerobot_tavis.eval.episode_log import EpisodeLogger, metric_fields
 from lerobot_tavis.eval.report import build_report, markdown, write_report
-from lerobot_tavis.metrics import registry
+from lerobot_tavis.metrics import logged_metrics
 from lerobot_tavis.metrics.episode_metric import Episode, EpisodeMetric, Histogram
 from lerobot_tavis.metrics.galt_metric import GALT
 from lerobot_tavis.metrics.wrist_lead_metric import WRIST_LEAD
@@ -33,22 +33,22 @@ class Duration(EpisodeMetric):
 
 @pytest.fixture
 def toy_registered(monkeypatch):
-    monkeypatch.setattr(registry, "_METRICS", list(registry._METRICS))  # undone after the test
-    return registry.register(Duration())
+    monkeypatch.setattr(logged_metrics, "_METRICS", list(logged_metrics._METRICS))  # undone after the test
+    return logged_metrics.register(Duration())
 
 
 def test_the_registry_holds_galt_then_the_wrist_lead():
-    assert registry.episode_metrics() == (GALT, WRIST_LEAD)
+    assert logged_metrics.episode_metrics() == (GALT, WRIST_LEAD)
     assert (GALT.value_field, GALT.reason_field) == ("galt_s", "galt_reason")
 
 
 def test_register_refuses_a_taken_name_or_field_and_a_metric_without_its_value_field(monkeypatch):
-    monkeypatch.setattr(registry, "_METRICS", list(registry._METRICS))
+    monkeypatch.setattr(logged_metrics, "_METRICS", list(logged_metrics._METRICS))
     with pytest.raises(ValueError, match="already registered"):
-        registry.register(type("Again", (Duration,), {"name": "galt"})())
+        logged_metrics.register(type("Again", (Duration,), {"name": "galt"})())
     with pytest.raises(ValueError, match="must list 'duration_s'"):
-        registry.register(type("Partial", (Duration,), {"fields": ("duration_reason",)})())
-    assert registry.episode_metrics() == (GALT, WRIST_LEAD)
+        logged_metrics.register(type("Partial", (Duration,), {"fields": ("duration_reason",)})())
+    assert logged_metrics.episode_metrics() == (GALT, WRIST_LEAD)
 
 
 def test_a_metric_that_does_not_apply_logs_none_and_unlisted_fields_are_refused():

@@ -12,7 +12,7 @@ from lerobot_tavis.envs.tasks.multi_shelf_scan import SHELF_DEPTH, SHELF_X
 from lerobot_tavis.eval.episode_log import EpisodeLogger
 from lerobot_tavis.envs.tasks.catalog import SUITES, suite_tasks
 from lerobot_tavis.experts.base import Hold, Move, play
-from lerobot_tavis.experts.registry import make_expert, run_episode
+from lerobot_tavis.experts.rollout import make_expert, run_episode
 from lerobot_tavis.metrics.galt import compute_galt
 
 TASKS = [task for suite in SUITES for task in suite_tasks(suite)]

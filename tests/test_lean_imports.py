@@ -11,8 +11,8 @@ import sys
 WORKER = """
 import json, sys
 import lerobot_tavis.dataset_tools.record, lerobot_tavis.eval.protocol  # where worker jobs are unpickled from
-from lerobot_tavis.envs.factory import make_tavis_env
-from lerobot_tavis.experts.registry import run_episode
+from lerobot_tavis.eval.env_factory import make_tavis_env
+from lerobot_tavis.experts.rollout import run_episode
 
 env = make_tavis_env("wait_then_act", "gr1t2", "head_wrist", "id", (96, 128), 2.0, episode_log=sys.argv[1])
 result = run_episode(env, seed=0)

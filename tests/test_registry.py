@@ -23,7 +23,7 @@ from lerobot_tavis.envs.robots.gr1t2 import GR1T2
 from lerobot_tavis.envs.tasks.base import TargetFacts, Task, lift_conditions
 from lerobot_tavis.envs.tasks.catalog import expand_tasks
 from lerobot_tavis.experts.base import Expert, Hold, Move, Segment
-from lerobot_tavis.experts.registry import make_expert, run_episode
+from lerobot_tavis.experts.rollout import make_expert, run_episode
 
 # -- a toy task: the red cube on the table, lift it ---------------------------------------------------------------
 TOY_TASK = registry.TaskInfo(
@@ -156,7 +156,7 @@ def test_a_registered_task_robot_and_mode_run_in_the_env_with_the_demonstrator(t
 
 
 def test_registered_names_reach_the_config_the_cli_and_suite_expansion(toys):
-    from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
 
     assert expand_tasks("toy_suite") == {"toy_suite": ["toy_lift_cube"]}
     config = TavisEnvConfig(task="toy_suite", robot="toy_gr1t2", camera_mode=TOY_MODE)

@@ -31,7 +31,7 @@ _RENDER = """
 import json, sys
 import numpy as np
 from lerobot_tavis.envs.env import TavisEnv
-from lerobot_tavis.experts.registry import make_expert
+from lerobot_tavis.experts.rollout import make_expert
 scenes, views, size, delay, out = json.loads(sys.argv[1])
 frames = {}
 for task, robot in scenes:

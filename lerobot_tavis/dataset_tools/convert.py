@@ -29,13 +29,13 @@ from tqdm import tqdm
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.dataset_tools import features as ft
-from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
 from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
-from lerobot_tavis.dataset_tools.staging import staged_directory
-from lerobot_tavis.dataset_tools.workers import executor
+from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeError, load_episode
 from lerobot_tavis.envs.tasks.catalog import task_sort_key
 from lerobot_tavis.errors import FieldError, InputError, TavisError
 from lerobot_tavis.locking import exclusive_output
+from lerobot_tavis.staging import staged_directory
+from lerobot_tavis.workers import executor
 
 CONVERSION_LOG = "meta/tavis_conversion.json"
 RAW_IMAGE_SIZE = (480, 640)  # (H, W) of the cameras rendered from raw episodes unless told otherwise

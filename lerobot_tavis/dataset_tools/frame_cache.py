@@ -83,8 +83,8 @@ def write_frame_cache(cfg: CacheFramesConfig) -> list[str]:
 
     from tqdm import tqdm
 
-    from lerobot_tavis.dataset_tools.staging import staged_directory
-    from lerobot_tavis.dataset_tools.workers import executor
+    from lerobot_tavis.staging import staged_directory
+    from lerobot_tavis.workers import executor
 
     root = Path(cfg.root).absolute()
     if not (root / "meta" / "info.json").is_file():

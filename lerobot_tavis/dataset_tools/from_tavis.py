@@ -39,9 +39,9 @@ import numpy as np
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.dataset_tools import features as ft
 from lerobot_tavis.dataset_tools.quiet import quiet_media_libraries
-from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, PROTOCOL_SPLITS
 from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError
+from lerobot_tavis.staging import staged_directory
 
 SOURCE_CAMERAS = {
     "observation.images.OBS_HEAD": "head",

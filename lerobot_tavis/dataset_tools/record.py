@@ -22,11 +22,11 @@ from tqdm import tqdm
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.dataset_tools.raw import Manifest, ManifestEntry, RawEpisode, episode_filename, save_episode
-from lerobot_tavis.dataset_tools.workers import BACKENDS, executor
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_names
 from lerobot_tavis.envs.tasks.catalog import SUITES, expand_tasks, split_names
 from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.locking import exclusive_output
+from lerobot_tavis.workers import BACKENDS, executor
 
 RECORD_FPS = 60
 
@@ -166,7 +166,7 @@ def record_episode(robot: str, task: str, split: str, seed: int,
                    keep_failures: bool) -> tuple[ManifestEntry, RawEpisode | None]:
     """Play one demonstrator episode at 60 Hz; returns its manifest entry and, if kept, the episode (the calling
     process writes it). Runs in a worker."""
-    from lerobot_tavis.experts.registry import run_episode
+    from lerobot_tavis.experts.rollout import run_episode
 
     env = _env(robot, task, split)
     states = StateLog()

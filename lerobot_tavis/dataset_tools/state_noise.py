@@ -34,10 +34,10 @@ import numpy as np
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools.features import STATE_KEY
 from lerobot_tavis.dataset_tools.frames import INFO, check_files, dataset_info
-from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.envs.transforms import quat_angles_rad
 from lerobot_tavis.errors import FieldError, InputError, PathExistsError, PathNotFoundError
 from lerobot_tavis.readers import get_integer, read_parquet
+from lerobot_tavis.staging import staged_directory
 
 NOISE_RECORD = "meta/state_noise.json"
 STATS_PREFIX = f"stats/{STATE_KEY}/"  # per-episode statistics columns in meta/episodes/*.parquet

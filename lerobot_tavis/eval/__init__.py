@@ -1,1 +1,2 @@
-"""Evaluation: the per-episode log, the report, and the 96-episode protocol runner."""
+"""Evaluation: `--env.type=tavis` (the LeRobot env config and its sub-envs), the per-episode log, the report, and the
+96-episode protocol runner."""

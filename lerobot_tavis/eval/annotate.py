@@ -4,7 +4,7 @@ lerobot-eval films `TavisEnv.render()`: the overview beside the policy's views, 
 success, all known while the episode runs. The events (head arrival on the final fixation, hand onset, grasp) are
 known only once it is over, in the episode log. For every `videos/<suite>_<task_id>/eval_episode_<i>.mp4` of an
 evaluation, this writes `videos_annotated/<suite>_<task_id>/eval_episode_<i>.mp4` with the caption band redrawn
-from episode i's log record (episode i is the one with seed start_seed + i, as `report.join` pairs them).
+from episode i's log record (episode i is the one with seed start_seed + i, as `outputs.join` pairs them).
 Videos are annotated by worker processes side by side (a protocol films 60); this process writes them, in a fixed
 order. A copy newer than its video is kept: `tavis eval` annotates each finished chunk's videos while the other
 chunks still play (`Annotator`), so its report has none left to do.
@@ -17,12 +17,12 @@ from concurrent.futures import Future
 from pathlib import Path
 
 from lerobot_tavis.atomic import write_bytes
-from lerobot_tavis.dataset_tools.workers import executor
 from lerobot_tavis.envs.physics import POLICY_HZ
-from lerobot_tavis.eval.report import join
+from lerobot_tavis.eval.outputs import join
 from lerobot_tavis.media import encode_mp4, iter_mp4
 from lerobot_tavis.overlay import Caption, EpisodeEvents, redraw_caption
 from lerobot_tavis.process import MAX_NICENESS
+from lerobot_tavis.workers import executor
 
 ANNOTATED_DIR = "videos_annotated"
 

@@ -1,6 +1,6 @@
 """Protocol cells as (cell, task, seed chunk) jobs spread over every worker, for the demonstrators and policies.
 
-All chunks of all pending cells go to one pool (`dataset_tools.workers`: local processes or Ray), so every core,
+All chunks of all pending cells go to one pool (`workers`: local processes or Ray), so every core,
 or every share of a GPU, stays busy whatever the number of tasks. A chunk's outcome depends only on its task,
 split and seeds (a policy chunk is one lerobot-eval run seeded with its first seed), each chunk's results come back
 to this process, and each cell is assembled in a fixed order (task, then seed) once its last chunk is done: the
@@ -35,15 +35,15 @@ from pathlib import Path
 from tqdm import tqdm
 
 from lerobot_tavis.atomic import write_text
-from lerobot_tavis.dataset_tools.staging import staged_directory
-from lerobot_tavis.dataset_tools.workers import executor, usable_cores
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.annotate import ANNOTATED_DIR, Annotator, episode_index
 from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
-from lerobot_tavis.eval.report import EVAL_INFO_NAME
+from lerobot_tavis.eval.outputs import EVAL_INFO_NAME
 from lerobot_tavis.eval.run_identity import RUN_FIELD, RUN_FILE
 from lerobot_tavis.policies import register_policy_types
+from lerobot_tavis.staging import staged_directory
+from lerobot_tavis.workers import executor, usable_cores
 
 METRICS = ("successes", "sum_rewards", "max_rewards")  # per-episode lists of lerobot-eval's per-task metrics
 ENV_WORKER_NICENESS = 10  # env workers yield contended cores to the policy's process, use idle ones; same outcomes
@@ -140,9 +140,9 @@ _ENVS: dict[tuple, object] = {}  # per process: the last chunk's (task, split) -
 def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
     """Play one chunk with the demonstrators (in a worker)."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from lerobot_tavis.envs.factory import make_tavis_env
+    from lerobot_tavis.eval.env_factory import make_tavis_env
     from lerobot_tavis.eval.episode_log import EpisodeLogger
-    from lerobot_tavis.experts.registry import run_episode
+    from lerobot_tavis.experts.rollout import run_episode
 
     key = (chunk.task, chunk.split)
     if key not in _ENVS:
@@ -183,7 +183,7 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
     worker)."""
     from lerobot.configs.default import EvalConfig
 
-    from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
     from lerobot_tavis.eval.lerobot_run import evaluate, pipeline_config
 
     if cfg.device != "cpu":

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis.errors import InputError
-from lerobot_tavis.eval.report import eval_dirs, join
+from lerobot_tavis.eval.outputs import eval_dirs, join
 from lerobot_tavis.metrics.stats import mcnemar_exact_p
 
 

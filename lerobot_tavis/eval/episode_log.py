@@ -3,7 +3,7 @@ metric.
 
 The wrapper sits inside `envs.vector.FreezeAfterEpisodeEnd`, so it sees each genuine episode once. It records the
 actions the env actually applied (after clipping, and with the neck zeroed in fixed-camera modes) and, when an
-episode ends, writes the fields of every metric of `lerobot_tavis.metrics.registry`, in its order, computed from
+episode ends, writes the fields of every metric of `lerobot_tavis.metrics.logged_metrics`, in its order, computed from
 them at the env's rate (20 Hz in evaluation): GALT for successful episodes of head-camera modes, as the reference
 does, and the wrist lead of the final grasp for successful TAVIS-Hands episodes. The metric fields are also added
 to that step's `info`. Before them, `conditions` holds the final step's `info["conditions"]`: the parts of the
@@ -21,11 +21,10 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from lerobot_tavis.envs.factory import EPISODE_LOG_NAME
 from lerobot_tavis.metrics.episode_metric import Episode
-from lerobot_tavis.metrics.registry import episode_metrics
+from lerobot_tavis.metrics.logged_metrics import episode_metrics
 
-__all__ = ["EPISODE_LOG_NAME", "EpisodeLogger", "metric_fields"]
+EPISODE_LOG_NAME = "episodes.jsonl"  # the episode log's file name in an evaluation's output directory
 
 
 def metric_fields(episode: Episode) -> dict:

@@ -27,7 +27,7 @@ import numpy as np
 
 from lerobot_tavis.atomic import write_text
 from lerobot_tavis.envs.vector import LazyAsyncVectorEnv
-from lerobot_tavis.eval.report import EVAL_INFO_NAME
+from lerobot_tavis.eval.outputs import EVAL_INFO_NAME
 
 _KEPT: dict[tuple, LazyAsyncVectorEnv] = {}  # this process's kept one-task async batch, by what fixes its workers
 

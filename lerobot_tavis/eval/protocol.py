@@ -22,7 +22,6 @@ from pathlib import Path
 
 from lerobot_tavis import checks
 from lerobot_tavis.cli_options import option, spelling
-from lerobot_tavis.dataset_tools.workers import BACKENDS
 from lerobot_tavis.envs.checkpoint_settings import (CheckpointSettings, match_settings, pretrained_model_dir,
                                                     read_checkpoint_settings)
 from lerobot_tavis.envs.modes import DEFAULT_CAMERA_MODE, RENAMED_MODES, camera_mode_names, resolve_camera_mode
@@ -32,10 +31,12 @@ from lerobot_tavis.envs.tasks.catalog import (BENCHMARK_TASKS, PROTOCOL_SPLITS, 
                                               task_info)
 from lerobot_tavis.errors import FieldError, InputError
 from lerobot_tavis.eval.cell_runs import played_tasks, run_cells
-from lerobot_tavis.eval.report import EVAL_INFO_NAME, read_eval_info, write_report
+from lerobot_tavis.eval.outputs import EVAL_INFO_NAME, read_eval_info
+from lerobot_tavis.eval.report import write_report
 from lerobot_tavis.eval.run_identity import (RUN_FIELD, RUN_FILE, difference_text, differences, read_identity,
                                              run_identity)
 from lerobot_tavis.locking import exclusive_output
+from lerobot_tavis.workers import BACKENDS
 
 START_SEED = 1000
 

@@ -1,2 +1,2 @@
 """Benchmark metrics: success statistics, GALT, and the episode metrics the log writes and the report summarises
-(`registry.py`). Numpy only (plus `envs.modes`, pure Python): no MuJoCo, LeRobot or torch."""
+(`logged_metrics.py`). Numpy only (plus `envs.modes`, pure Python): no MuJoCo, LeRobot or torch."""

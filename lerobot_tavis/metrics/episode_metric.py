@@ -7,7 +7,7 @@ not apply) and `tavis report` summarises `<name>_s` and `<name>_reason` per task
 count, reason counts), with a table and, when the metric has a `Histogram`, a plot per task.
 
 Adding a metric: one module defining an `EpisodeMetric` subclass instance, plus one line in
-`lerobot_tavis.metrics.registry`.
+`lerobot_tavis.metrics.logged_metrics`.
 """
 
 from __future__ import annotations

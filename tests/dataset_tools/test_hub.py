@@ -231,7 +231,7 @@ def checkpoint(tmp_path):
 
 
 def test_policy_card_names_env_robot_task_cameras_data_recipe_commands_and_results(checkpoint):
-    from lerobot_tavis.policies.hub import policy_card
+    from lerobot_tavis.policy_hub import policy_card
 
     card = policy_card(checkpoint, POLICY_REPO, RESULTS)
     front_matter = card.split("---\n")[1]
@@ -259,7 +259,7 @@ def test_policy_card_names_env_robot_task_cameras_data_recipe_commands_and_resul
 def test_push_policy_uploads_the_checkpoint_card_and_results_in_one_commit(checkpoint, hub, uploads, monkeypatch):
     from huggingface_hub import HfApi
 
-    from lerobot_tavis.policies.hub import policy_card, push_policy
+    from lerobot_tavis.policy_hub import policy_card, push_policy
 
     staged = {}
 
@@ -300,7 +300,7 @@ def test_push_policy_out_writes_the_upload_ready_folder_without_network_or_login
 
 
 def test_push_policy_refuses_before_uploading(checkpoint, hub, uploads, monkeypatch, tmp_path):
-    from lerobot_tavis.policies.hub import push_policy
+    from lerobot_tavis.policy_hub import push_policy
 
     with pytest.raises(HubError, match="not logged in"):
         push_policy(checkpoint, POLICY_REPO)

@@ -7,7 +7,7 @@ import pytest
 from lerobot_tavis.envs import visual_ood
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, VISUAL_FACTORS, parse_split, split_names
-from lerobot_tavis.experts.registry import make_expert
+from lerobot_tavis.experts.rollout import make_expert
 
 SIZE = (48, 64)
 

@@ -47,7 +47,7 @@ def test_one_env_gets_a_batch_dimension_and_bad_images_are_refused():
 
 KEEP_AND_EXIT = """
 import multiprocessing, sys
-from lerobot_tavis.envs.config import TavisEnvConfig
+from lerobot_tavis.eval.env_config import TavisEnvConfig
 from lerobot_tavis.eval import lerobot_run
 
 def keep_a_batch():

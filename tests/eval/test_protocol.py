@@ -10,9 +10,9 @@ import sys
 import pytest
 
 from lerobot_tavis.cli import main
-from lerobot_tavis.eval import protocol
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import FieldError, InputError
+from lerobot_tavis.eval import protocol
 from lerobot_tavis.eval.cell_runs import run_cells
 from lerobot_tavis.eval.protocol import Cell, ProtocolConfig, run_protocol
 from lerobot_tavis.eval.report import write_report
@@ -229,7 +229,7 @@ def _diffusion_checkpoint(path, image_size):
     from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
     from lerobot.policies.factory import make_policy, make_pre_post_processors
 
-    from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
 
     config = DiffusionConfig(pretrained_backbone_weights=None, device="cpu", push_to_hub=False,
                              down_dims=(16, 32, 64), horizon=16, n_action_steps=8, num_inference_steps=2)
@@ -291,8 +291,8 @@ def _policy_run(checkpoint, out, task, keep_workers):
 
     from lerobot.configs.default import EvalConfig
 
-    from lerobot_tavis.envs.config import TavisEnvConfig
     from lerobot_tavis.eval.cell_runs import policy_config
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
     from lerobot_tavis.eval.lerobot_run import evaluate, pipeline_config
 
     policy = policy_config(SimpleNamespace(policy_path=str(checkpoint), device="cpu",
@@ -365,7 +365,7 @@ def test_lerobot_eval_of_a_checkpoint_renders_the_size_it_was_trained_at(tmp_pat
         f"--policy.path={tmp_path / 'ckpt'}", "--policy.device=cpu", "--eval.n_episodes=1", "--eval.batch_size=1",
         "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'out'}"])
     monkeypatch.setenv("HF_HUB_OFFLINE", "1")
-    with caplog.at_level(logging.INFO, logger="lerobot_tavis.envs.config"):
+    with caplog.at_level(logging.INFO, logger="lerobot_tavis.eval.env_config"):
         lerobot_eval.eval_main()
     assert "the env takes the checkpoint's image_size 32x48" in caplog.text
     (record,) = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
@@ -376,7 +376,7 @@ def test_the_eval_config_of_a_checkpoint_does_not_warn_of_random_weights(caplog)
     from lerobot.configs.eval import EvalPipelineConfig
     from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
 
-    from lerobot_tavis.envs.config import TavisEnvConfig
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
     from lerobot_tavis.eval.lerobot_run import pipeline_config
 
     policy = DiffusionConfig(pretrained_path="ckpt")

@@ -4,7 +4,8 @@ import json
 
 import pytest
 
-from lerobot_tavis.eval.report import build_report, join, markdown, write_report
+from lerobot_tavis.eval.outputs import join
+from lerobot_tavis.eval.report import build_report, markdown, write_report
 
 
 def _record(task, task_id, seed, success, split="id", galt=None):

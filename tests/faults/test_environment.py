@@ -18,9 +18,9 @@ from pathlib import Path
 import pytest
 
 from lerobot_tavis.atomic import NAME_MAX_BYTES, write_text
-from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.errors import PathExistsError
 from lerobot_tavis.eval.report import build_report
+from lerobot_tavis.staging import staged_directory
 from tests.eval.test_report import _eval_dir
 
 EXPERT_EVAL = ["eval", "--expert", "--tasks", "conditional_pick", "--splits", "id", "--episode-length-s", "0.5"]
@@ -140,7 +140,7 @@ def test_a_valid_long_name_gets_its_staging_copy_and_a_name_too_long_is_one_line
 def test_a_killed_run_with_a_long_name_leaves_a_staging_copy_the_next_run_removes(tmp_path):
     destination = tmp_path / ("d" * 240)
     killed = subprocess.run([sys.executable, "-c", "import os, sys\n"
-                             "from lerobot_tavis.dataset_tools.staging import staged_directory\n"
+                             "from lerobot_tavis.staging import staged_directory\n"
                              "with staged_directory(sys.argv[1]) as staging:\n"
                              "    staging.mkdir()\n"
                              "    os.kill(os.getpid(), 9)\n", str(destination)])

@@ -125,8 +125,8 @@ def test_a_damaged_episode_log_line_is_reported_with_its_place(tmp_path, line, p
     ({"image_size": (0, 64)}, "image_size must be within 16..4096 pixels per side"),
 ])
 def test_env_and_env_config_name_the_bad_field(kwargs, message):
-    from lerobot_tavis.envs.config import TavisEnvConfig
     from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
 
     with pytest.raises(ValueError) as env_error:
         TavisEnv("conditional_pick", **kwargs)

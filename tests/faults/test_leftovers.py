@@ -8,8 +8,8 @@ import subprocess
 import sys
 import time
 
-from lerobot_tavis.dataset_tools.staging import staged_directory
 from lerobot_tavis.eval.report import build_report
+from lerobot_tavis.staging import staged_directory
 from tests.eval.test_report import _eval_dir
 
 

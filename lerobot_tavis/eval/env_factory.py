@@ -1,16 +1,14 @@
 """One sub-env of `--env.type=tavis`: the TavisEnv, wrapped by the episode log when there is one.
 
 LeRobot's async vector envs and `tavis eval --expert` call `make_tavis_env` in worker processes, which import this
-module by name: it must import neither LeRobot nor torch (the env config that refers to it does). The episode log
-(`lerobot_tavis.eval.episode_log`) is imported only inside `make_tavis_env`, when one is asked for: this module
-is the one place where the env side attaches it (docs/extending.md, "Layers").
+module by name: it must import neither LeRobot nor torch (the env config that refers to it does).
 """
 
 from __future__ import annotations
 
 import gymnasium as gym
 
-EPISODE_LOG_NAME = "episodes.jsonl"  # the episode log's file name in an evaluation's output directory
+from lerobot_tavis.eval.episode_log import EpisodeLogger
 
 
 def make_tavis_env(task: str, robot: str, camera_mode: str, split: str, image_size: tuple[int, int],
@@ -26,7 +24,5 @@ def make_tavis_env(task: str, robot: str, camera_mode: str, split: str, image_si
     env = TavisEnv(task, robot, camera_mode=camera_mode, split=split, image_size=tuple(image_size),
                    episode_length_s=episode_length_s, cameras=cameras, shadows=shadows)
     if episode_log:
-        from lerobot_tavis.eval.episode_log import EpisodeLogger
-
         env = EpisodeLogger(env, episode_log, suite=suite, task_id=task_id)
     return env

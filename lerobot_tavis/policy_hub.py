@@ -23,6 +23,7 @@ from lerobot_tavis.envs.checkpoint_settings import (POLICY_CONFIG_NAME, TRAIN_CO
                                                     settings_from_configs)
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SUITES
 from lerobot_tavis.errors import InputError, PathNotFoundError
+from lerobot_tavis.policy_configs import presets
 
 TAGS = ("lerobot", "tavis", "robotics")
 WEIGHTS_NAME = "model.safetensors"
@@ -34,8 +35,6 @@ def policy_card(checkpoint: str | Path, repo_id: str, results: dict | None = Non
     """The model card (README.md, Markdown with YAML front matter) of the checkpoint folder `checkpoint` published
     as `repo_id`; `results`: a `tavis report` results.json, parsed."""
     from huggingface_hub import ModelCardData
-
-    from lerobot_tavis.policy_configs import presets
 
     folder = Path(checkpoint)
     policy = json.loads((folder / POLICY_CONFIG_NAME).read_text())

@@ -17,10 +17,10 @@ from lerobot.envs.utils import preprocess_observation
 
 import lerobot_env_tavis  # noqa: F401  (registers the env type, as LeRobot's CLIs do)
 from lerobot_tavis import canonical
-from lerobot_tavis.envs.config import TavisEnvConfig, expand_tasks
-from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.envs.env import scene_seed
+from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.envs.vector import NEW_ROLLOUT_OPTION, FreezeAfterEpisodeEnd, LazyAsyncVectorEnv
+from lerobot_tavis.eval.env_config import TavisEnvConfig, expand_tasks
 from lerobot_tavis.eval.episode_log import EpisodeLogger
 
 
@@ -192,8 +192,8 @@ def test_retargeted_workers_build_the_new_task_in_the_same_processes():
 
 def test_a_retarget_that_fails_in_the_workers_raises_at_the_next_use():
     """`retarget` does not wait for the workers; their error comes with the next reset, naming what was wrong."""
-    from lerobot_tavis.envs.factory import make_tavis_env
     from lerobot_tavis.errors import FieldError
+    from lerobot_tavis.eval.env_factory import make_tavis_env
 
     vec = TavisEnvConfig(task="wait_then_act", image_size=(24, 32)).create_envs(2, True)["tavis_head"][1]
     try:

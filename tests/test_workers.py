@@ -4,8 +4,8 @@ import os
 
 import pytest
 
-from lerobot_tavis.dataset_tools.workers import InlineExecutor, executor
 from lerobot_tavis.errors import FieldError
+from lerobot_tavis.workers import InlineExecutor, executor
 
 
 def test_local_workers_run_at_the_given_niceness_above_this_process():

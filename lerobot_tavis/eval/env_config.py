@@ -27,12 +27,13 @@ from lerobot.envs.configs import EnvConfig
 
 from lerobot_tavis import canonical, checks
 from lerobot_tavis.envs.checkpoint_settings import SETTINGS, match_settings, read_checkpoint_settings
-from lerobot_tavis.envs.factory import EPISODE_LOG_NAME, make_tavis_env
 from lerobot_tavis.envs.modes import CAMERA_MODES, DEFAULT_CAMERA_MODE, resolve_camera_mode
 from lerobot_tavis.envs.robots import DEFAULT_ROBOT, robot_info
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SUITES, expand_tasks, parse_split, suite_tasks
 from lerobot_tavis.envs.vector import Frozen, LazyAsyncVectorEnv
 from lerobot_tavis.errors import FieldError
+from lerobot_tavis.eval.env_factory import make_tavis_env
+from lerobot_tavis.eval.episode_log import EPISODE_LOG_NAME
 from lerobot_tavis.process import MAX_NICENESS
 
 # The help of `--env.task`, written from the task registry (draccus reads other fields' help from their comments).
