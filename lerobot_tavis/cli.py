@@ -164,6 +164,24 @@ def _cache_frames_command():
     return CacheFramesConfig, _printing(write_frame_cache)
 
 
+def _table_add_command():
+    from lerobot_tavis.eval.baselines import TableAddConfig, run_table_add
+
+    return TableAddConfig, _printing(run_table_add)
+
+
+def _table_command():
+    from lerobot_tavis.eval.baselines_table import TableConfig, run_table
+
+    return TableConfig, _printing(run_table)
+
+
+def _ablation_command():
+    from lerobot_tavis.eval.baselines_table import AblationConfig, run_ablation
+
+    return AblationConfig, _printing(run_ablation)
+
+
 def _report(options: ReportOptions) -> None:
     from lerobot_tavis.eval.report import write_report
 
@@ -332,16 +350,13 @@ def build_parser() -> argparse.ArgumentParser:
          "success by training step from one eval output per checkpoint (step_<N>/): checkpoints.md and .png"),
         ("compare", _at_hand(CompareOptions, _compare),
          "two evaluations of the same seeds, episode by episode: successes of each and the exact McNemar test"),
-        ("table-add", "lerobot_tavis.eval.baselines:TableAddConfig",
-         _printing("lerobot_tavis.eval.baselines:run_table_add"),
+        ("table-add", _table_add_command,
          "add (or replace) one cell of the baselines table in docs/results/baselines.json, checked against its "
          "results.json"),
-        ("table", "lerobot_tavis.eval.baselines_table:TableConfig",
-         _printing("lerobot_tavis.eval.baselines_table:run_table"),
+        ("table", _table_command,
          "the baselines table from docs/results/baselines.json: per robot, tasks x conditions and splits with Wilson "
          "CIs, GALT, pooled rows, the paper's numbers and targets (Markdown), and its plot"),
-        ("ablation", "lerobot_tavis.eval.baselines_table:AblationConfig",
-         _printing("lerobot_tavis.eval.baselines_table:run_ablation"),
+        ("ablation", _ablation_command,
          "the wrist-only ablation (clutter_pick_cube with and without the head camera's active vision against "
          "blocked_clutter_pick_cube) from the baselines table: Wilson CIs and exact McNemar"),
     ):

@@ -111,7 +111,7 @@ def push_policy(checkpoint: str | Path, repo_id: str, *, results: str | Path | N
         raise PathNotFoundError(f"{folder} holds no {WEIGHTS_NAME}: pass a checkpoint's pretrained_model folder")
     report = _read_results(Path(results)) if results is not None else None
     if out is not None:
-        from lerobot_tavis.dataset_tools.staging import staged_directory
+        from lerobot_tavis.staging import staged_directory
 
         with staged_directory(out, overwrite=True) as staged:
             _stage(folder, policy_card(folder, repo_id, report), results, staged)

@@ -284,7 +284,7 @@ def test_push_policy_uploads_the_checkpoint_card_and_results_in_one_commit(check
 
 
 def test_push_policy_out_writes_the_upload_ready_folder_without_network_or_login(checkpoint, hub, uploads, tmp_path):
-    from lerobot_tavis.policies.hub import policy_card, push_policy
+    from lerobot_tavis.policy_hub import policy_card, push_policy
 
     results, out = tmp_path / "results.json", tmp_path / "model"
     out.mkdir()
