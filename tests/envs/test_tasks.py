@@ -85,13 +85,16 @@ def test_the_docs_state_the_success_thresholds_of_the_code():
 
 @pytest.mark.parametrize("task_name", TAVIS_TASKS)
 def test_each_tasks_row_in_the_docs_names_the_threshold_its_success_rule_uses(task_name):
-    """The success cell of the task's docs/tasks.md row names the constant the class's `evaluate` tests, and the
-    declaration's rule text states its value."""
+    """The success cell of the task's docs/tasks.md row and its row of docs/evaluation.md's conditions table name the
+    constant the class's `evaluate` tests, and the declaration's rule text states its value."""
     (row,) = [row for row in _table_rows(ROOT / "docs" / "tasks.md") if row[:2] == [TASKS[task_name].suite, task_name]]
+    (conditions_row,) = [row for row in _table_rows(ROOT / "docs" / "evaluation.md")
+                         if f"`{task_name}`" in re.findall(r"`\w+`", row[0])]
     cls = catalog.task_class(task_name)
     threshold = multi_shelf_scan.SHELF_EXIT_X_M if task_name == "multi_shelf_scan" else cls.success_height_m
     (named,) = re.findall(r"(?:above|x =) `([A-Z_]+)`", row[3])
     assert getattr(info, named, getattr(multi_shelf_scan, named, None)) == threshold
+    assert set(re.findall(r"`([A-Z_]+_M)`", conditions_row[1])) == {named}
     assert f"{threshold:.3f}".rstrip("0") in TASKS[task_name].success_rule
     speed = info.MAX_SUCCESS_SPEED_M_S
     assert "`MAX_SUCCESS_SPEED_M_S`" in row[3] and f"{speed:g} m/s" in TASKS[task_name].success_rule
