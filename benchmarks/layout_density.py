@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS, RED_CUBE
-from lerobot_tavis.envs.tasks.clutter_pick_lift import CLUTTER_VARIANTS, ClutterVariant, footprint
+from lerobot_tavis.envs.tasks.clutter_pick_lift.task import CLUTTER_VARIANTS, ClutterVariant, footprint
 from lerobot_tavis.envs.tasks.layout import REFERENCE_TRIES, Pose2D, overlaps, sample_layout
 
 TASKS = {"clutter_pick_cube": (*OBJECT_NAMES, RED_CUBE.name), "clutter_pick_lift": OBJECT_NAMES}

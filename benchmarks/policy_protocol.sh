@@ -8,13 +8,12 @@
 #   for one step on eight conditional_pick demonstrations: it never succeeds, so every episode runs its full 20 s.
 #   Eight, so that both arms move in them: a state dimension that never changes (the idle arm of two left-hand
 #   picks) is normalised by a range of 0 (LeRobot divides by 1e-8), so the first episode that moves it
-#   (ood_init_pose) feeds the policy values near 1e7, past float16's range under AMP, and gets NaN actions back
-#   (2026-11-26, after 768 episodes).
+#   (ood_init_pose) feeds the policy values near 1e7, past float16's range under AMP, and gets NaN actions back.
 # - protocol: the protocol with that checkpoint (or CHECKPOINT), DDIM with STEPS (10) denoising steps and AMP on
 #   DEVICE (cuda), WORKERS (3) jobs sharing the GPU, BATCH (32) envs per job, FILM (4) filmed episodes per task
-#   and split; writes $WORK/protocol/ and $WORK/protocol_footprint.json. 3 jobs of 32 and 8 jobs of 12 stepped
-#   about as many envs per second (505 and 550, a third of what 96 rendering env workers reach alone:
-#   docs/benchmarks.md), so the default is the one with fewer policy copies on the GPU.
+#   and split; writes $WORK/protocol/ and $WORK/protocol_footprint.json. 3 jobs of 32 step about as many envs per
+#   second as 8 jobs of 12 (docs/results/history.md, "Speed and memory"), so the default is the one with fewer
+#   policy copies on the GPU.
 #
 # Settings (environment variables): WORK (/tmp/tavis_protocol), SPLITS ("id ood_spatial ood_init_pose"), EPISODES
 # (96), and those above.

@@ -27,7 +27,7 @@ from lerobot_tavis.envs.tasks.catalog import parse_split, task_info
 from lerobot_tavis.errors import InputError, TavisError
 from lerobot_tavis.readers import checked, expect, get, get_integer, read_json
 
-TOLERANCE_M = 0.015  # replayed hands stay within 1.3 cm of a 60 Hz recording at 20 Hz (measured, 20 episodes)
+TOLERANCE_M = 0.015  # a faithful 20 Hz replay of a 60 Hz recording keeps its hands this close (docs/datasets.md)
 HOLD_S = 1.0
 
 

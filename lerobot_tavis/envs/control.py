@@ -76,7 +76,7 @@ class ArmIK:
 
     def reach_error(self, action: np.ndarray, side: str, iterations: int = 200) -> tuple[float, float]:
         """Kinematic check of a canonical action: iterate IK from the home pose and return the remaining position
-        (m) and orientation (rad) error of `side`'s hand. Cheap enough (~25 ms) for planners to compare options."""
+        (m) and orientation (rad) error of `side`'s hand. Cheap enough for planners to compare options."""
         self.set_targets(hand_targets(self.robot, action))
         q = self.home_q.copy()
         for _ in range(iterations):

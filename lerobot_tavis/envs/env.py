@@ -24,8 +24,7 @@ from lerobot_tavis.envs.reach import ReachTracker
 from lerobot_tavis.envs.rendering import CameraRig
 from lerobot_tavis.envs.robots import make_robot
 from lerobot_tavis.envs.tasks.base import EpisodeFacts, TargetFacts
-from lerobot_tavis.envs.tasks.catalog import VISUAL_SPLIT, parse_split, task_info
-from lerobot_tavis.envs.tasks.registry import make_task
+from lerobot_tavis.envs.tasks.catalog import VISUAL_SPLIT, make_task, parse_split, task_info
 from lerobot_tavis.envs.world import World, build_world
 from lerobot_tavis.errors import FieldError
 

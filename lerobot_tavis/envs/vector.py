@@ -1,9 +1,9 @@
 """Vector envs for `--env.type=tavis` whose worker processes stay lean: they import neither torch nor LeRobot.
 
 LeRobot's own lazy async vector env wraps every sub-env factory in a closure of `lerobot.envs.utils`, so each
-worker that unpickles one imports that module, and with it torch: 0.7-0.9 GB resident per worker instead of about
-0.3 (measured: a `tavis eval --policy` job's env workers), enough to exhaust a 128 GB machine with 8 jobs of 12
-envs. This module gives the same two behaviours from classes that import only gymnasium:
+worker that unpickles one imports that module, and with it torch, which multiplies a worker's memory (docs/
+benchmarks.md, "Worker footprint") and so the memory of a protocol's many env workers. This module gives the same
+two behaviours from classes that import only gymnasium:
 
 - `FreezeAfterEpisodeEnd`: once a sub-env's episode has ended, further steps and Gymnasium's autoresets replay its
   terminal transition (reward 0) instead of simulating, until an explicit reset carrying LeRobot's new-rollout
@@ -11,11 +11,11 @@ envs. This module gives the same two behaviours from classes that import only gy
 - `LazyAsyncVectorEnv`: the AsyncVectorEnv (forkserver workers, shared memory, next-step autoreset) is created on
   first use, so one task's workers are alive at a time while lerobot-eval walks a suite. Only its first
   `filmed_envs` sub-envs draw video frames: lerobot-eval films at most 10 episodes of a batch, from its first
-  sub-envs, yet asks every sub-env of an async batch for a frame at each step (about 1 MB each, the overview
-  rendered, composed and sent through a pipe); the others answer `render()` with None, and `call("render")`
+  sub-envs, yet asks every sub-env of an async batch for a frame at each step (the overview rendered,
+  composed and sent through a pipe); the others answer `render()` with None, and `call("render")`
   returns the filmed ones' frames alone, so that lerobot-eval films `min(filmed_envs, 10)` episodes. lerobot-eval
-  also asks every sub-env for its `task_description` at each step, a round trip through all the workers (4.4 ms per
-  step for 32 envs, one H100 machine); a prompt changes only at a reset, so it is asked once per reset.
+  also asks every sub-env for its `task_description` at each step, a round trip through all the workers that the
+  policy's process waits for; a prompt changes only at a reset, so it is asked once per reset.
   `worker_niceness` lowers the workers' CPU priority (added to their niceness, as `nice`), so that the process that
   runs the policy is not delayed by them when the cores are contended. `retarget` gives started workers other
   sub-envs (another task or split, same spaces) without starting new processes, and without waiting for them.

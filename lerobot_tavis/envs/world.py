@@ -59,9 +59,9 @@ def build_world(robot: Robot, task: Task, *, image_size: tuple[int, int], shadow
 
 def release_compiler_memory() -> None:
     """Give back what compiling a scene leaves behind in this process: MuJoCo's process-wide asset cache (the
-    decoded textures and meshes, about 23 MB with the YCB objects; it only speeds up compiling the same assets
-    again, 0.1 s instead of 0.02 s) and, under glibc, the heap pages the compiler freed (`malloc_trim`). A
-    simulating worker holds about 48 MB less (docs/benchmarks.md, worker footprint)."""
+    decoded textures and meshes; it only speeds up compiling the same assets again) and, under glibc, the heap
+    pages the compiler freed (`malloc_trim`): memory a simulating worker would otherwise hold for nothing
+    (docs/benchmarks.md, "Worker footprint")."""
     mujoco.mj_clearCache(mujoco.mj_getCache())
     libc_name = ctypes.util.find_library("c")
     libc = ctypes.CDLL(libc_name) if libc_name else None

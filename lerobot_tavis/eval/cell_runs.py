@@ -127,7 +127,7 @@ def _completed(cfg, fn: Callable, jobs: list[tuple]) -> Iterator:
         futures = [pool.submit(fn, *job) for job in jobs]
         try:
             for done, future in enumerate(as_completed(futures), 1):
-                if done == len(futures):  # the workers exit while the last result is handled (6 s for policy jobs)
+                if done == len(futures):  # the workers exit while the last result is handled
                     pool.shutdown(wait=False)
                 yield future.result()
         finally:
@@ -146,7 +146,7 @@ def _play_expert_chunk(cfg, chunk: Chunk) -> ChunkResult:
 
     key = (chunk.task, chunk.split)
     if key not in _ENVS:
-        _close_envs()  # one compiled scene per worker: each holds about 70 MB
+        _close_envs()  # one compiled scene per worker: each holds its model and data
         _ENVS[key] = make_tavis_env(chunk.task, cfg.robot, cfg.camera_mode, chunk.split, cfg.image_size,
                                     cfg.episode_length_s, cameras=())  # the demonstrators read the state
     with tempfile.TemporaryDirectory(prefix="tavis-chunk-") as scratch:
@@ -211,9 +211,9 @@ def _play_policy_chunk(cfg, chunk: Chunk) -> ChunkResult:
 def _share_cores(jobs: int) -> None:
     """Give this job's torch its share of the cores this process may run on (its CPU affinity: `taskset`, a
     container's cpuset). Each process's torch uses every core by default, so `jobs` policy jobs at once
-    oversubscribed them (16-core GPU machine, 5 jobs: 80 torch threads, each job's main process at 200-500% CPU
-    while its env workers waited). Only for a policy on an accelerator: there the CPU work is element-wise; a policy
-    on the CPU keeps torch's default, as its results would depend on the thread count, and so on `--workers`."""
+    oversubscribed them (each job's main process busy on many cores while its env workers waited). Only for a
+    policy on an accelerator: there the CPU work is element-wise; a policy on the CPU keeps torch's default, as its
+    results would depend on the thread count, and so on `--workers`."""
     import torch
 
     torch.set_num_threads(max(1, usable_cores() // jobs))
@@ -249,8 +249,8 @@ def _keep_chunk(work: Path, result: ChunkResult, identity: dict) -> None:
 
 def _annotate_chunk(annotator: Annotator, work: Path, result: ChunkResult) -> None:
     """Have the chunk's videos annotated beside them (`<stem>.videos_annotated/`) while other chunks play: the
-    report would otherwise annotate a protocol's 60 videos after its last rollout (45 s on the one-H100 machine,
-    docs/benchmarks.md). Video i is the episode of the chunk's seed first_seed + i."""
+    report would otherwise annotate a protocol's videos after its last rollout, one after the other. Video i is
+    the episode of the chunk's seed first_seed + i."""
     chunk = result.chunk
     records = {record["seed"]: record for record in map(json.loads, result.log_text.splitlines())}
     for name in sorted(result.videos):

@@ -1,12 +1,11 @@
 """One lerobot-eval run inside this process, filming as many episodes as its env config's `filmed_envs`.
 
 LeRobot's `eval_main` films the first 10 episodes of every task, and while it films a batch it holds every frame of
-the batch's filmed episodes in memory, then a second, stacked copy while the videos are written: about
-2 x 400 steps x 10 episodes x 1.3 MB = 10 GB per run at 240x320, which is what ended the protocol runs that shared
-one GPU machine (docs/benchmarks.md). `evaluate` builds the run exactly as `eval_main` does (LeRobot's env, policy
-and processors from the same `EvalPipelineConfig`), then calls LeRobot's `eval_policy_all` filming the episodes of
-the sub-envs that draw frames (`TavisEnvConfig.filmed_envs`); it writes the same `eval_info.json`. With
-`filmed_envs=0` no frame is rendered for a video at all.
+the batch's filmed episodes in memory, then a second, stacked copy while the videos are written: two copies of 10
+episodes of 400 frames per run, more memory than several jobs sharing one GPU machine have. `evaluate` builds the
+run exactly as `eval_main` does (LeRobot's env, policy and processors from the same `EvalPipelineConfig`), then calls
+LeRobot's `eval_policy_all` filming the episodes of the sub-envs that draw frames (`TavisEnvConfig.filmed_envs`); it
+writes the same `eval_info.json`. With `filmed_envs=0` no frame is rendered for a video at all.
 
 LeRobot's own progress bars (one per batch and one per rollout, nested) are off: the caller draws one bar for its
 whole run (`tavis eval`'s `cell_runs`). Its rollout converts each step's camera images from uint8 to float on the
@@ -67,8 +66,7 @@ def images_converted_on(device):
     `preprocess_observation` unchanged.
 
     LeRobot converts them on the CPU, in the process that also runs the policy, and its device processor then
-    copies four times the bytes to the GPU: 13 ms a step for the 96 images of 32 envs at 240x320 with three
-    cameras, on the one-GPU machine (docs/benchmarks.md), while that job's envs wait. Here each pixel value looks up
+    copies four times the bytes to the GPU, while that job's envs wait. Here each pixel value looks up
     its float in a table that LeRobot's CPU conversion computed (a division by 255 on the GPU rounds 126 of the 256
     values differently, like a multiplication by the reciprocal), so the tensors are the same, already on `device`."""
     import torch
@@ -130,8 +128,7 @@ def _env_batches(cfg, keep_workers: bool) -> tuple[dict, bool]:
     """make_env's batches for `cfg`, and whether they are kept for a next run. With `keep_workers`, a one-task async
     batch stays started after the run, and the next run with the same robot, camera mode, image size, episode length,
     shadows, batch size and worker niceness retargets its workers to its own task and split instead of starting new
-    ones: 32 env workers with three cameras took 25-33 s to start beside two other jobs' on a 16-CPU share of a GPU
-    machine, the GPU idle meanwhile (docs/benchmarks.md)."""
+    ones: starting a batch's workers (imports, EGL contexts, scenes) leaves the GPU idle at every chunk."""
     from lerobot.envs import make_env
 
     env = cfg.env

@@ -189,8 +189,7 @@ def run_protocol(cfg: ProtocolConfig) -> list[Path]:
         _check_other_cells(cfg, cells, identity)
         pending = [cell for cell in cells if not _finished(cfg, cell, identity)]
         # A bad --policy-option fails in the first job, when it reads the checkpoint's config: checking it here
-        # first would import LeRobot in this process too, which held back the start of every job by 27 s on the
-        # one-H100 machine (docs/benchmarks.md).
+        # first would import LeRobot in this process too, holding back the start of every job.
         started = time.perf_counter()
         run_cells(cfg, pending, identity)
         played = time.perf_counter()

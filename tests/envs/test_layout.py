@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
-from lerobot_tavis.envs.tasks.clutter_pick_lift import CLUTTER_VARIANTS, footprint
+from lerobot_tavis.envs.tasks.clutter_pick_lift.task import CLUTTER_VARIANTS, footprint
 from lerobot_tavis.envs.tasks.layout import CONTACT_GAP_M, Box2D, Footprint, Pose2D, overlaps, sample_layout
 
 CIRCLE = Footprint(radius_m=0.03)

@@ -7,7 +7,7 @@ import pytest
 from lerobot_tavis.envs import physics, placement
 from lerobot_tavis.envs.objects import PROPS, RED_CUBE, YCB_OBJECTS, add_prop
 from lerobot_tavis.envs.robots import make_robot
-from lerobot_tavis.envs.tasks.registry import make_task
+from lerobot_tavis.envs.tasks.catalog import make_task
 from lerobot_tavis.envs.world import build_world
 
 FIT_TOLERANCE_M = 0.002

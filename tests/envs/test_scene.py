@@ -13,11 +13,10 @@ from lerobot_tavis.envs import physics, scene
 from lerobot_tavis.envs.assets import ASSET_DIR
 from lerobot_tavis.envs.env import TavisEnv
 from lerobot_tavis.envs.robots import make_robot
-from lerobot_tavis.envs.tasks import multi_shelf_scan
-from lerobot_tavis.envs.tasks.catalog import BUILTIN_TASKS, task_class
-from lerobot_tavis.envs.tasks.conditional_pick import CARD
-from lerobot_tavis.envs.tasks.registry import make_task
-from lerobot_tavis.envs.tasks.wait_then_act import LIGHT
+from lerobot_tavis.envs.tasks.catalog import BUILTIN_TASKS, make_task, task_class
+from lerobot_tavis.envs.tasks.conditional_pick.task import CARD
+from lerobot_tavis.envs.tasks.multi_shelf_scan import task as shelf_task
+from lerobot_tavis.envs.tasks.wait_then_act.task import LIGHT
 from lerobot_tavis.envs.world import build_world
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -103,9 +102,9 @@ def test_key_light_direction_and_strength_per_task():
     np.testing.assert_allclose(key.dir, np.divide(scene.KEY_LIGHT_DIR, np.linalg.norm(scene.KEY_LIGHT_DIR)),
                                atol=1e-6)
     shelf_key = shelf.light(scene.KEY_LIGHT)
-    expected = np.divide(multi_shelf_scan.KEY_LIGHT_DIR, np.linalg.norm(multi_shelf_scan.KEY_LIGHT_DIR))
+    expected = np.divide(shelf_task.KEY_LIGHT_DIR, np.linalg.norm(shelf_task.KEY_LIGHT_DIR))
     np.testing.assert_allclose(shelf_key.dir, expected, atol=1e-6)
-    np.testing.assert_allclose(shelf_key.diffuse, key.diffuse * multi_shelf_scan.KEY_LIGHT_INTENSITY
+    np.testing.assert_allclose(shelf_key.diffuse, key.diffuse * shelf_task.KEY_LIGHT_INTENSITY
                                / scene.KEY_LIGHT_INTENSITY, atol=1e-6)
     assert shelf.nlight == default.nlight == 1
 

@@ -13,11 +13,12 @@ from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.env import WARM_UP_HEAD_STD_RAD, WARM_UP_POSITION_STD_M, TavisEnv, warm_up_action
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.robots import make_robot
-from lerobot_tavis.envs.tasks import catalog, multi_shelf_scan, peeking_box
-from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SUITES, TASKS, suite_tasks
-from lerobot_tavis.envs.tasks.clutter_pick_lift import footprint
+from lerobot_tavis.envs.tasks import catalog, info, multi_shelf_scan
+from lerobot_tavis.envs.tasks.multi_shelf_scan import task as shelf_task
+from lerobot_tavis.envs.tasks.peeking_box import task as peeking_box
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, SUITES, TASKS, make_task, suite_tasks
+from lerobot_tavis.envs.tasks.clutter_pick_lift.task import footprint
 from lerobot_tavis.envs.tasks.layout import CONTACT_GAP_M, Pose2D, overlaps
-from lerobot_tavis.envs.tasks.registry import make_task
 from lerobot_tavis.envs.world import build_world
 
 TAVIS_TASKS = list(BENCHMARK_TASKS)
@@ -70,15 +71,33 @@ def test_suites_hold_the_reference_tasks_and_the_docs_list_the_registry():
 def test_the_docs_state_the_success_thresholds_of_the_code():
     """docs/tasks.md and the demonstrators' comments write each threshold as "`NAME` = value"; every value is the
     constant's, and the shelf's threshold is its front edge less 3 cm."""
-    constants = {name: getattr(catalog, name) for name in
-                 ("LIFT_HEIGHT_M", "HIGH_LIFT_HEIGHT_M", "SHELF_EXIT_X_M", "MAX_SUCCESS_SPEED_M_S")}
+    constants = {name: getattr(module, name) for module, names in
+                 ((info, ("LIFT_HEIGHT_M", "HIGH_LIFT_HEIGHT_M", "MAX_SUCCESS_SPEED_M_S")),
+                  (multi_shelf_scan, ("SHELF_EXIT_X_M",))) for name in names}
     texts = [ROOT / "docs" / "tasks.md", *sorted((ROOT / "lerobot_tavis" / "experts").glob("*.py"))]
     stated = [(name, float(value)) for path in texts
               for name, value in re.findall(r"`([A-Z_]+)` = (\d+(?:\.\d+)?)", path.read_text())]
     assert {name for name, _ in stated} == set(constants)
     for name, value in stated:
         assert value == pytest.approx(constants[name], abs=1e-9), name
-    assert catalog.SHELF_EXIT_X_M == multi_shelf_scan.SHELF_X - multi_shelf_scan.SHELF_DEPTH / 2 - 0.03
+    assert multi_shelf_scan.SHELF_EXIT_X_M == multi_shelf_scan.SHELF_X - multi_shelf_scan.SHELF_DEPTH / 2 - 0.03
+
+
+@pytest.mark.parametrize("task_name", TAVIS_TASKS)
+def test_each_tasks_row_in_the_docs_names_the_threshold_its_success_rule_uses(task_name):
+    """The success cell of the task's docs/tasks.md row and its row of docs/evaluation.md's conditions table name the
+    constant the class's `evaluate` tests, and the declaration's rule text states its value."""
+    (row,) = [row for row in _table_rows(ROOT / "docs" / "tasks.md") if row[:2] == [TASKS[task_name].suite, task_name]]
+    (conditions_row,) = [row for row in _table_rows(ROOT / "docs" / "evaluation.md")
+                         if f"`{task_name}`" in re.findall(r"`\w+`", row[0])]
+    cls = catalog.task_class(task_name)
+    threshold = multi_shelf_scan.SHELF_EXIT_X_M if task_name == "multi_shelf_scan" else cls.success_height_m
+    (named,) = re.findall(r"(?:above|x =) `([A-Z_]+)`", row[3])
+    assert getattr(info, named, getattr(multi_shelf_scan, named, None)) == threshold
+    assert set(re.findall(r"`([A-Z_]+_M)`", conditions_row[1])) == {named}
+    assert f"{threshold:.3f}".rstrip("0") in TASKS[task_name].success_rule
+    speed = info.MAX_SUCCESS_SPEED_M_S
+    assert "`MAX_SUCCESS_SPEED_M_S`" in row[3] and f"{speed:g} m/s" in TASKS[task_name].success_rule
 
 
 @pytest.mark.parametrize("variant", VARIANTS)
@@ -143,9 +162,9 @@ def test_multi_shelf_scan_layout(variant):
         assert len(set(task.slots.values())) == 5
         for name, (shelf, slot_y) in task.slots.items():
             x, y = _xy(model, data, name)
-            assert multi_shelf_scan.SLOT_X_CLAMP[0] - 1e-9 <= x <= multi_shelf_scan.SLOT_X_CLAMP[1] + 1e-9
+            assert shelf_task.SLOT_X_CLAMP[0] - 1e-9 <= x <= shelf_task.SLOT_X_CLAMP[1] + 1e-9
             assert abs(y - slot_y) <= task.variant.jitter_y_m + 1e-9 and abs(y) <= 0.32 + 1e-9
-        assert task.prompt in multi_shelf_scan.SHELF_PROMPTS[task.target]
+        assert task.prompt in multi_shelf_scan.PROMPTS[task.target]
 
 
 @pytest.mark.parametrize("variant", VARIANTS)

@@ -54,7 +54,7 @@ class Pose:
     `upside_down` turns it 180 degrees about the prop's x axis; `yaw_deg` then turns it about the vertical
     (a multiple of 180 for box props, whose sides must stay on the collision box's; for a can, which of its two
     round axes became x is arbitrary but fixed by the scan, and the yaw brings its label round). `faces` is the
-    triangle budget of the decimation (rendering costs about 0.11 ms per 1,000 triangles in view on a CPU).
+    triangle budget of the decimation (a CPU renderer's time grows with the triangles in view).
     """
 
     source_id: str

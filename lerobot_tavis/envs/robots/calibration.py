@@ -30,7 +30,7 @@ class RestCalibration:
 
 @functools.cache
 def calibrate(robot_cls) -> RestCalibration:
-    """Solve once per robot class (deterministic; ~0.3 s)."""
+    """Solve once per robot class (deterministic)."""
     robot = robot_cls()
     model = robot.raw_spec().compile()
     configuration = mink.Configuration(model)

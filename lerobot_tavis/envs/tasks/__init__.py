@@ -1,1 +1,2 @@
-"""The tasks: one module each, metadata in `catalog` (no MuJoCo), classes by name in `registry`."""
+"""The tasks: one package each (`<task>/__init__.py` declares it without MuJoCo, `<task>/task.py` simulates it),
+collected by name in `catalog`."""

@@ -24,7 +24,7 @@ import numpy as np
 
 from lerobot_tavis.envs.objects import OBJECT_NAMES, YCB_OBJECTS, add_prop
 from lerobot_tavis.envs.placement import body_speed
-from lerobot_tavis.envs.tasks.catalog import LIFT_HEIGHT_M, MAX_SUCCESS_SPEED_M_S, TaskInfo
+from lerobot_tavis.envs.tasks.info import LIFT_HEIGHT_M, MAX_SUCCESS_SPEED_M_S, TaskInfo
 
 # `evaluate` reports measured quantities to the millimetre (mm/s): bit-level differences between runs of the same
 # episode (a policy's arithmetic in another process, say) stay out of the episode log. Decisions use exact values.
@@ -103,7 +103,8 @@ class Task(abc.ABC):
 
 
 class YcbTask(Task, abc.ABC):
-    """A task with the five YCB objects (those not used in an episode wait off-stage) and one target prop."""
+    """A task with the five YCB objects (those not used in an episode wait off-stage) and one target prop; its
+    `evaluate` is the lift rule at `success_height_m` (world z, m; the built-in tasks set their declaration's)."""
 
     success_height_m: ClassVar[float] = LIFT_HEIGHT_M
 

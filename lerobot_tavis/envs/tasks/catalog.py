@@ -1,147 +1,32 @@
-"""The task registry: each task's suite, prompts, success rule, splits, task class and demonstrator, readable
-without MuJoCo.
+"""The task registry: every task's declaration (`TaskInfo`: suite, prompts, success rule, splits, task class and
+demonstrator) by name, readable without MuJoCo, and the look-ups the CLIs, configs and env use.
 
-`TASKS` below is the one place a task is declared, with the thresholds of its success rule as named constants
-that the task class's `evaluate`, the rule's text here and docs/tasks.md all use. Its task class (one module each
-next to this file) and its demonstrator (`lerobot_tavis.experts`) are named by import path and imported only when an
-env or a demonstrator is built, so CLIs and configs validate names and expand suites without loading a simulator.
-Tasks from outside the package join with `register_task` (docs/extending.md).
+A built-in task declares itself once, in its package `envs/tasks/<task>/` (`__init__.py`: its `INFO`, prompts and
+success thresholds; `task.py`: the class simulating it); `BUILTIN_DECLARATIONS` below lists them in catalog order.
+Task classes and demonstrators are named by import path and imported only when an env or a demonstrator is built,
+so CLIs and configs validate names and expand suites without loading a simulator. Tasks from outside the package
+join with `register_task` (docs/extending.md).
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 from lerobot_tavis import importpath
-from lerobot_tavis.errors import FieldError, InputError
+from lerobot_tavis.envs.tasks import (blocked_clutter_pick_cube, clutter_pick_cube, clutter_pick_lift,
+                                      conditional_pick, multi_shelf_scan, occluded_reach, peeking_box, tabletop,
+                                      wait_then_act)
+from lerobot_tavis.envs.tasks.info import TaskInfo
+# The splits a task may offer, named here as well for the registry's users (CLIs, configs, datasets, reports).
+from lerobot_tavis.envs.tasks.splits import (PROTOCOL_SPLITS, SPLITS, VISUAL_FACTORS, VISUAL_SPLIT,
+                                             parse_split, split_names)
+from lerobot_tavis.errors import FieldError
 
-SPLITS = ("id", "ood_spatial", "ood_init_pose", "ood_visual")
-# ood_visual (envs/visual_ood.py) changes only the look; `ood_visual:<factor>` applies one factor alone.
-VISUAL_SPLIT = "ood_visual"
-VISUAL_FACTORS = ("table", "floor", "backdrop", "lighting", "distractors")
-PROTOCOL_SPLITS = ("id", "ood_spatial", "ood_init_pose")  # the reference's three, the default of `tavis eval`
-
-
-def parse_split(split: str) -> tuple[str, tuple[str, ...]]:
-    """`ood_visual` -> ("ood_visual", VISUAL_FACTORS); `ood_visual:lighting` -> ("ood_visual", ("lighting",));
-    another split -> (split, ()). Raises ValueError for an unknown split or factor."""
-    name, _, factor = split.partition(":")
-    if name not in SPLITS:
-        raise FieldError("split", f"must be one of {split_names()}, got {split!r}")
-    if name != VISUAL_SPLIT:
-        if factor:
-            raise InputError(f"only {VISUAL_SPLIT} takes a factor (e.g. {VISUAL_SPLIT}:lighting), got {split!r}")
-        return name, ()
-    if not factor:
-        return name, VISUAL_FACTORS
-    if factor not in VISUAL_FACTORS:
-        raise InputError(f"the factor of {VISUAL_SPLIT} must be one of {VISUAL_FACTORS}, got {factor!r}")
-    return name, (factor,)
-
-
-def split_names() -> tuple[str, ...]:
-    """Every accepted split name: the splits, and `ood_visual:<factor>` per factor."""
-    return (*SPLITS, *(f"{VISUAL_SPLIT}:{factor}" for factor in VISUAL_FACTORS))
-
-
-@dataclass(frozen=True)
-class TaskInfo:
-    """One task. `task_class` (an `envs.tasks.base.Task` subclass) and `demonstrator` (an `experts.base.Expert`
-    subclass; None: the task has none) are import paths "package.module:Class", imported on first use, or the
-    classes themselves."""
-
-    name: str
-    suite: str
-    prompts: tuple[str, ...]
-    success_rule: str
-    splits: tuple[str, ...] = SPLITS
-    task_class: str | type = ""
-    demonstrator: str | type | None = None
-
-
-LIFT_PROMPTS = {
-    "soup_can": ("Pick up the tomato soup can and lift it.", "Grasp the soup can and hold it up.",
-                 "Lift the red soup can off the table."),
-    "meat_can": ("Pick up the potted meat can and lift it.", "Grasp the can of spam and hold it up.",
-                 "Lift the meat can off the table."),
-    "tuna_fish_can": ("Pick up the tuna fish can and lift it.", "Grasp the tuna can and hold it up.",
-                      "Lift the tuna fish can off the table."),
-    "gelatin_box": ("Pick up the gelatin box and lift it.", "Grasp the gelatin box and hold it up.",
-                    "Lift the gelatin box off the table."),
-    "pudding_box": ("Pick up the pudding box and lift it.", "Grasp the pudding box and hold it up.",
-                    "Lift the pudding box off the table."),
-}
-SHELF_PROMPTS = {
-    "soup_can": ("Find the tomato soup can on the shelf and bring it to me.",
-                 "Retrieve the soup can from the shelves.",
-                 "Look through the shelves, find the red soup can, and take it."),
-    "meat_can": ("Find the potted meat can on the shelf and bring it to me.",
-                 "Retrieve the spam can from the shelves.",
-                 "Look through the shelves, find the meat can, and take it."),
-    "tuna_fish_can": ("Find the tuna fish can on the shelf and bring it to me.",
-                      "Retrieve the tuna can from the shelves.",
-                      "Look through the shelves, find the tuna can, and take it."),
-    "gelatin_box": ("Find the gelatin box on the shelf and bring it to me.",
-                    "Retrieve the gelatin box from the shelves.",
-                    "Look through the shelves, find the gelatin box, and take it."),
-    "pudding_box": ("Find the pudding box on the shelf and bring it to me.",
-                    "Retrieve the pudding box from the shelves.",
-                    "Look through the shelves, find the pudding box, and take it."),
-}
-CUBE_PROMPT = "Find the red cube and pick it up."
-
-# Success thresholds (world frame; docs/reference.md §4). The target's origin must be:
-LIFT_HEIGHT_M = 1.2  # above this z: the Head tasks that lift, and blocked_clutter_pick_cube
-HIGH_LIFT_HEIGHT_M = 1.25  # above this z: peeking_box and occluded_reach
-SHELF_EXIT_X_M = 0.52 - 0.11 / 2 - 0.03  # 0.435, nearer than this x: the shelf's front edge (x 0.52, depth 0.11) - 3 cm
-MAX_SUCCESS_SPEED_M_S = 1.0  # and slower than this (m/s), in every task
-SPEED_RULE = f"moving slower than {MAX_SUCCESS_SPEED_M_S:g} m/s"
-LIFT_RULE = "the {what}'s origin is above {z} m and " + SPEED_RULE
-
-TASKS_PKG, HEAD_EXPERTS, HANDS_EXPERTS = ("lerobot_tavis.envs.tasks", "lerobot_tavis.experts.head_tasks",
-                                          "lerobot_tavis.experts.hands_tasks")
-# The registry, in catalog order (tables, datasets, plots follow it). `register_task` adds to it.
-TASKS: dict[str, TaskInfo] = {
-    info.name: info
-    for info in (
-        TaskInfo("conditional_pick", "tavis_head",
-                 ("Look at the card. If it is red, pick the object on the left. If it is green, pick the object on "
-                  "the right.",),
-                 LIFT_RULE.format(what="target (left object if the card is red, right if green)", z=LIFT_HEIGHT_M),
-                 task_class=f"{TASKS_PKG}.conditional_pick:ConditionalPick",
-                 demonstrator=f"{HEAD_EXPERTS}:ConditionalPickExpert"),
-        TaskInfo("wait_then_act", "tavis_head",
-                 ("Watch the red light. When it turns green, pick up the object.",),
-                 "once the light is green: " + LIFT_RULE.format(what="object", z=LIFT_HEIGHT_M),
-                 task_class=f"{TASKS_PKG}.wait_then_act:WaitThenAct", demonstrator=f"{HEAD_EXPERTS}:WaitThenActExpert"),
-        TaskInfo("clutter_pick_cube", "tavis_head", (CUBE_PROMPT,), LIFT_RULE.format(what="red cube", z=LIFT_HEIGHT_M),
-                 task_class=f"{TASKS_PKG}.clutter_pick_cube:ClutterPickCube",
-                 demonstrator=f"{HEAD_EXPERTS}:ClutterExpert"),
-        TaskInfo("clutter_pick_lift", "tavis_head", tuple(p for ps in LIFT_PROMPTS.values() for p in ps),
-                 LIFT_RULE.format(what="named object", z=LIFT_HEIGHT_M),
-                 task_class=f"{TASKS_PKG}.clutter_pick_lift:ClutterPickLift",
-                 demonstrator=f"{HEAD_EXPERTS}:ClutterExpert"),
-        TaskInfo("multi_shelf_scan", "tavis_head", tuple(p for ps in SHELF_PROMPTS.values() for p in ps),
-                 f"the named object's origin is closer than x = {SHELF_EXIT_X_M:.3f} m (out of the shelf) and "
-                 + SPEED_RULE,
-                 task_class=f"{TASKS_PKG}.multi_shelf_scan:MultiShelfScan", demonstrator=f"{HEAD_EXPERTS}:ShelfExpert"),
-        TaskInfo("peeking_box", "tavis_hands", ("Retrieve the object from inside the box.",),
-                 LIFT_RULE.format(what="object", z=HIGH_LIFT_HEIGHT_M),
-                 task_class=f"{TASKS_PKG}.peeking_box:PeekingBox", demonstrator=f"{HANDS_EXPERTS}:PeekingBoxExpert"),
-        TaskInfo("occluded_reach", "tavis_hands", ("Reach around the screen and pick up the object behind it.",),
-                 LIFT_RULE.format(what="object", z=HIGH_LIFT_HEIGHT_M),
-                 task_class=f"{TASKS_PKG}.occluded_reach:OccludedReach",
-                 demonstrator=f"{HANDS_EXPERTS}:OccludedReachExpert"),
-        TaskInfo("blocked_clutter_pick_cube", "tavis_hands", (CUBE_PROMPT,),
-                 LIFT_RULE.format(what="red cube", z=LIFT_HEIGHT_M) + "; the head camera image is black",
-                 task_class=f"{TASKS_PKG}.blocked_clutter_pick_cube:BlockedClutterPickCube",
-                 demonstrator=f"{HANDS_EXPERTS}:BlockedClutterExpert"),
-        TaskInfo("tabletop", "sandbox", ("Look at the objects on the table.",),
-                 "never succeeds: a free scene (the five YCB objects on the table) for trying the robots",
-                 splits=("id",), task_class=f"{TASKS_PKG}.tabletop:Tabletop"),
-    )
-}
+# In catalog order: tables, datasets and plots follow it.
+BUILTIN_DECLARATIONS = (conditional_pick, wait_then_act, clutter_pick_cube, clutter_pick_lift, multi_shelf_scan,
+                        peeking_box, occluded_reach, blocked_clutter_pick_cube, tabletop)
+# The registry, in catalog order; `register_task` adds to it.
+TASKS: dict[str, TaskInfo] = {module.INFO.name: module.INFO for module in BUILTIN_DECLARATIONS}
 SUITES = ("tavis_head", "tavis_hands")  # the benchmark's suites: closed, `register_task` adds to other suites
 
 
@@ -202,6 +87,12 @@ def unregister_task(name: str) -> None:
 def task_class(name: str) -> type:
     """The `Task` subclass of task `name` (importing it loads MuJoCo)."""
     return importpath.resolve(task_info(name).task_class)
+
+
+def make_task(name: str, variant: str = "id"):
+    """A new task `name` (an `envs.tasks.base.Task`; importing its class loads MuJoCo) with the variant (split)
+    `variant`."""
+    return task_class(name)(variant)
 
 
 def demonstrator_class(name: str) -> type | None:

@@ -1,8 +1,4 @@
-"""TAVIS-Hands peeking_box: an object inside a closed box with one open side (+y or -y); retrieve and lift it.
-
-The front and back walls span the full width, so the opening is not visible head-on: a wrist camera has to look.
-Success: the object's origin above `catalog.HIGH_LIFT_HEIGHT_M` and slower than `MAX_SUCCESS_SPEED_M_S`.
-"""
+"""peeking_box in MuJoCo: one object inside a box (a mocap body) whose +y or -y wall is taken away."""
 
 from __future__ import annotations
 
@@ -14,7 +10,7 @@ import numpy as np
 from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.tasks.base import TargetFacts, YcbTask
-from lerobot_tavis.envs.tasks.catalog import HIGH_LIFT_HEIGHT_M, TASKS
+from lerobot_tavis.envs.tasks.peeking_box import INFO, SUCCESS_HEIGHT_M
 from lerobot_tavis.envs.transforms import axis_angle_quat, matrix_from_quat
 
 BOX = "box"
@@ -87,8 +83,8 @@ class PeekingBoxFacts(TargetFacts):
 
 
 class PeekingBox(YcbTask):
-    info = TASKS["peeking_box"]
-    success_height_m = HIGH_LIFT_HEIGHT_M
+    info = INFO
+    success_height_m = SUCCESS_HEIGHT_M
     VARIANTS = {
         "id": BoxVariant((0.41, 0.45), (-0.04, 0.04), tuple(np.radians((-5.0, 5.0))), (-0.04, 0.04), (-0.02, 0.02)),
         "ood_spatial": BoxVariant((0.39, 0.47), (-0.04, 0.04), tuple(np.radians((-10.0, 10.0))), (-0.04, 0.04),

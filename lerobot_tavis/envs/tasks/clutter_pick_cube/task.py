@@ -1,4 +1,4 @@
-"""TAVIS-Head clutter_pick_cube: the red cube among four of the five YCB objects; pick up the cube."""
+"""clutter_pick_cube in MuJoCo: the red cube and four of the five YCB objects scattered on the table."""
 
 from __future__ import annotations
 
@@ -7,12 +7,13 @@ import numpy as np
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES, RED_CUBE, add_prop
 from lerobot_tavis.envs.tasks.base import YcbTask
-from lerobot_tavis.envs.tasks.catalog import TASKS
-from lerobot_tavis.envs.tasks.clutter_pick_lift import CLUTTER_VARIANTS, scatter
+from lerobot_tavis.envs.tasks.clutter_pick_cube import INFO, SUCCESS_HEIGHT_M
+from lerobot_tavis.envs.tasks.clutter_pick_lift.task import CLUTTER_VARIANTS, scatter
 
 
 class ClutterPickCube(YcbTask):
-    info = TASKS["clutter_pick_cube"]
+    info = INFO
+    success_height_m = SUCCESS_HEIGHT_M
     VARIANTS = CLUTTER_VARIANTS
 
     def __init__(self, variant: str = "id"):

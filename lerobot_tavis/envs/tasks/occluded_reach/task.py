@@ -1,8 +1,4 @@
-"""TAVIS-Hands occluded_reach: an object behind a portrait monitor; reach around the screen and lift it.
-
-The screen (fixed) hides the object from the head camera; success: the object's origin above
-`catalog.HIGH_LIFT_HEIGHT_M` and slower than `MAX_SUCCESS_SPEED_M_S`.
-"""
+"""occluded_reach in MuJoCo: one object on the table behind a fixed portrait monitor."""
 
 from __future__ import annotations
 
@@ -14,7 +10,7 @@ import numpy as np
 from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES
 from lerobot_tavis.envs.tasks.base import TargetFacts, YcbTask
-from lerobot_tavis.envs.tasks.catalog import HIGH_LIFT_HEIGHT_M, TASKS
+from lerobot_tavis.envs.tasks.occluded_reach import INFO, SUCCESS_HEIGHT_M
 from lerobot_tavis.envs.tasks.layout import Box2D
 
 FRAME_LOOK = scene.Look("screen_frame", (0.18, 0.18, 0.18, 1.0), specular=0.3, shininess=0.3)  # matte plastic
@@ -43,8 +39,8 @@ class OccludedReachFacts(TargetFacts):
 
 
 class OccludedReach(YcbTask):
-    info = TASKS["occluded_reach"]
-    success_height_m = HIGH_LIFT_HEIGHT_M
+    info = INFO
+    success_height_m = SUCCESS_HEIGHT_M
     VARIANTS = {
         "id": OccludedVariant(Box2D((0.40, 0.50), (-0.20, 0.20))),
         "ood_spatial": OccludedVariant(Box2D((0.36, 0.53), (-0.30, 0.30))),

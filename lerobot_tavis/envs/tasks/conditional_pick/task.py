@@ -1,4 +1,4 @@
-"""TAVIS-Head conditional_pick: a cue card's colour says which of two objects to lift (red: left, green: right)."""
+"""conditional_pick in MuJoCo: two YCB objects in their left and right zones, a red or green cue card between."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES, add_marker
 from lerobot_tavis.envs.scene import TABLE_TOP_Z, Look, use_look
 from lerobot_tavis.envs.tasks.base import TargetFacts, YcbTask
-from lerobot_tavis.envs.tasks.catalog import TASKS
+from lerobot_tavis.envs.tasks.conditional_pick import INFO, SUCCESS_HEIGHT_M
 from lerobot_tavis.envs.tasks.layout import Box2D
 
 CARD = "cue_card"
@@ -39,7 +39,8 @@ class ConditionalPickFacts(TargetFacts):
 
 
 class ConditionalPick(YcbTask):
-    info = TASKS["conditional_pick"]
+    info = INFO
+    success_height_m = SUCCESS_HEIGHT_M
     VARIANTS = {
         "id": ConditionalVariant(Box2D((0.35, 0.45), (0.15, 0.25)), Box2D((0.35, 0.45), (-0.25, -0.15)),
                                  Box2D((0.35, 0.45), (-0.05, 0.05))),

@@ -1,8 +1,4 @@
-"""TAVIS-Head multi_shelf_scan: five objects in six slots of a three-shelf unit; take the named one out.
-
-No table. Success: the target's origin is nearer than x = `catalog.SHELF_EXIT_X_M` (out of the shelf) and slower
-than `MAX_SUCCESS_SPEED_M_S`; no height condition (docs/reference.md §4).
-"""
+"""multi_shelf_scan in MuJoCo: a three-shelf unit (no table), five objects in six slots, its own key light."""
 
 from __future__ import annotations
 
@@ -15,9 +11,10 @@ from lerobot_tavis.envs import physics, placement, scene
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS
 from lerobot_tavis.envs.placement import body_speed
 from lerobot_tavis.envs.tasks.base import MEASURE_DECIMALS, YcbTask
-from lerobot_tavis.envs.tasks.catalog import MAX_SUCCESS_SPEED_M_S, SHELF_EXIT_X_M, SHELF_PROMPTS, TASKS
+from lerobot_tavis.envs.tasks.info import MAX_SUCCESS_SPEED_M_S
+from lerobot_tavis.envs.tasks.multi_shelf_scan import INFO, PROMPTS, SHELF_DEPTH, SHELF_EXIT_X_M, SHELF_X
 
-SHELF_X, SHELF_DEPTH, SHELF_WIDTH = 0.52, 0.11, 0.70
+SHELF_WIDTH = 0.70
 BOARD_THICKNESS = 0.02
 BOARD_Z = (0.97, 1.10, 1.27)  # centres of the three shelf boards; the top board is at 1.52
 TOP_BOARD_Z = 1.52
@@ -45,7 +42,7 @@ class ShelfVariant:
 
 
 class MultiShelfScan(YcbTask):
-    info = TASKS["multi_shelf_scan"]
+    info = INFO
     VARIANTS = {"id": ShelfVariant(0.03, 0.03), "ood_spatial": ShelfVariant(0.03, 0.10)}
     has_table = False
 
@@ -73,7 +70,7 @@ class MultiShelfScan(YcbTask):
         chosen = rng.choice(len(SLOTS), size=len(OBJECT_NAMES), replace=False)
         self.slots = {name: SLOTS[i] for name, i in zip(OBJECT_NAMES, chosen)}
         self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
-        self.prompt = SHELF_PROMPTS[self.target][rng.integers(3)]
+        self.prompt = PROMPTS[self.target][rng.integers(3)]
         for name, (shelf, slot_y) in self.slots.items():
             jitter = rng.uniform(-1.0, 1.0, size=2) * (self.variant.jitter_x_m, self.variant.jitter_y_m)
             yaw = rng.uniform(-np.pi, np.pi)

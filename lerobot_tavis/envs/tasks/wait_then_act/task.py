@@ -1,8 +1,4 @@
-"""TAVIS-Head wait_then_act: watch a red light; once it turns green (after a seeded delay), lift the object.
-
-Lifting before the light is green does not end the episode (as in the reference); success counts only once the
-light is green, and fires at once if the object is already held up when it turns.
-"""
+"""wait_then_act in MuJoCo: one object, and a signal light that turns from red to green after a drawn delay."""
 
 from __future__ import annotations
 
@@ -17,7 +13,7 @@ from lerobot_tavis.envs.objects import OBJECT_NAMES, add_marker
 from lerobot_tavis.envs.physics import POLICY_HZ
 from lerobot_tavis.envs.scene import TABLE_TOP_Z, Look, use_look
 from lerobot_tavis.envs.tasks.base import TargetFacts, YcbTask
-from lerobot_tavis.envs.tasks.catalog import TASKS
+from lerobot_tavis.envs.tasks.wait_then_act import INFO, SUCCESS_HEIGHT_M
 from lerobot_tavis.envs.tasks.layout import Box2D
 
 LIGHT = "signal_light"
@@ -46,7 +42,8 @@ class WaitThenActFacts(TargetFacts):
 
 
 class WaitThenAct(YcbTask):
-    info = TASKS["wait_then_act"]
+    info = INFO
+    success_height_m = SUCCESS_HEIGHT_M
     VARIANTS = {
         "id": WaitVariant(Box2D((0.35, 0.45), (-0.12, 0.12)), Box2D((0.60, 0.70), (-0.10, 0.10)), (2.0, 5.0)),
         "ood_spatial": WaitVariant(Box2D((0.30, 0.50), (-0.20, 0.20)), Box2D((0.55, 0.75), (-0.15, 0.15)),

@@ -1,4 +1,4 @@
-"""Sandbox scene: the five YCB objects standing in a row on the table; there is nothing to succeed at."""
+"""The tabletop sandbox in MuJoCo: the five YCB objects in a row, each jittered and turned."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import numpy as np
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES
 from lerobot_tavis.envs.tasks.base import YcbTask
-from lerobot_tavis.envs.tasks.catalog import TASKS
+from lerobot_tavis.envs.tasks.tabletop import INFO
 
 ROW_X = 0.42
 ROW_Y = np.linspace(0.24, -0.24, len(OBJECT_NAMES))
@@ -15,7 +15,7 @@ JITTER_M = 0.02
 
 
 class Tabletop(YcbTask):
-    info = TASKS["tabletop"]
+    info = INFO
     VARIANTS = {"id": None}
 
     def initialize_episode(self, model, data, rng: np.random.Generator) -> None:

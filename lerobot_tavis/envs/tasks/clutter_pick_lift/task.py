@@ -1,4 +1,5 @@
-"""TAVIS-Head clutter_pick_lift: five YCB objects scattered on the table; lift the one the prompt names."""
+"""clutter_pick_lift in MuJoCo: the five YCB objects scattered on the table, and the clutter sampler the cube
+tasks share."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 from lerobot_tavis.envs import placement
 from lerobot_tavis.envs.objects import OBJECT_NAMES, PROPS, PropSpec
 from lerobot_tavis.envs.tasks.base import YcbTask
-from lerobot_tavis.envs.tasks.catalog import LIFT_PROMPTS, TASKS
+from lerobot_tavis.envs.tasks.clutter_pick_lift import INFO, PROMPTS, SUCCESS_HEIGHT_M
 from lerobot_tavis.envs.tasks.layout import Box2D, Footprint, sample_layout
 
 
@@ -40,10 +41,11 @@ def scatter(model, data, rng: np.random.Generator, variant: ClutterVariant, name
 
 
 class ClutterPickLift(YcbTask):
-    info = TASKS["clutter_pick_lift"]
+    info = INFO
+    success_height_m = SUCCESS_HEIGHT_M
     VARIANTS = CLUTTER_VARIANTS
 
     def initialize_episode(self, model, data, rng: np.random.Generator) -> None:
         self.target = OBJECT_NAMES[rng.integers(len(OBJECT_NAMES))]
-        self.prompt = LIFT_PROMPTS[self.target][rng.integers(3)]
+        self.prompt = PROMPTS[self.target][rng.integers(3)]
         scatter(model, data, rng, self.variant, OBJECT_NAMES)
