@@ -2,7 +2,9 @@
 
 Each image draws only the geoms that can show in it or shadow what does (`out_of_view`): MuJoCo draws every geom in
 every pass, and with shadows each image takes three (the lit scene, the shadow map, the shadowed light), so a
-camera that sees a part of the scene saves most of its cost. The pixels are those of drawing everything.
+camera that sees a part of the scene saves most of its cost. Besides what lies outside the view, what stands under
+the table top where the top hides it is left out (`hidden_by_table`): MuJoCo draws a covered geom in every pass too.
+The pixels are those of drawing everything.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from contextlib import contextmanager
 import mujoco
 import numpy as np
 
-from lerobot_tavis.envs import physics
+from lerobot_tavis.envs import physics, scene
 from lerobot_tavis.envs.modes import WRIST_CAMERAS
 from lerobot_tavis.errors import TavisError
 
@@ -85,6 +87,7 @@ def out_of_view(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspe
 
     A shadow-casting geom is kept while the capsule swept by its sphere along a casting directional light, down to
     the floor (z = 0, below which nothing is drawn), reaches into the view: a shadow it casts falls within it.
+    Geoms that cast no shadow and that the table top hides (`hidden_by_table`) count as unseen too.
     Planes (unbounded) are always kept; so is every geom when the camera is not a plain perspective one, or when a
     light that is not directional casts shadows. The near plane culls; MuJoCo's far plane does not.
     """
@@ -105,7 +108,41 @@ def out_of_view(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspe
         reach = (np.maximum(centres[:, 2], 0.0) + radii) / -direction[2]
         swept_out = (outside & _outside(planes, centres + reach[:, None] * direction, radii)).any(axis=1)
         hidden &= ~casts | swept_out
+    hidden |= hidden_by_table(model, data, camera_id) & ~casts
     return hidden & (radii > 0)
+
+
+def hidden_by_table(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int) -> np.ndarray:
+    """(ngeom,) bool: the table's geoms that stand wholly under its top (legs, shelf, bins) and that its drawn top
+    surface (`scene.TABLE_SURFACE`, an axis-aligned plane) hides from camera `camera_id`: the camera is above the
+    surface and every line of sight to the geom's bounding box crosses the surface beyond the near clip plane (the
+    box's corners seen through the surface's plane all fall within the surface, which is convex)."""
+    hidden = np.zeros(model.ngeom, dtype=bool)
+    surface = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, scene.TABLE_SURFACE)
+    eye = data.cam_xpos[camera_id]
+    if surface < 0 or eye[2] <= data.geom_xpos[surface][2]:
+        return hidden
+    centre, half = data.geom_xpos[surface], model.geom_size[surface][:2]
+    table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, scene.TABLE_BODY)
+    top = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name) for name in scene.TABLE_TOP_GEOMS]
+    under = np.setdiff1d(np.flatnonzero(model.geom_bodyid == table), top)
+    corners = _box_corners(model, data, under)  # (n, 8, 3)
+    below = (corners[..., 2] < centre[2]).all(axis=1)
+    under, corners = under[below], corners[below]
+    through = eye + (eye[2] - centre[2]) / (eye[2] - corners[..., 2:3]) * (corners - eye)  # on the surface's plane
+    forward = -data.cam_xmat[camera_id].reshape(3, 3)[:, 2]
+    within = (np.abs(through[..., :2] - centre[:2]) < half).all(axis=-1)
+    beyond_near = (through - eye) @ forward > model.vis.map.znear * model.stat.extent
+    hidden[under] = (within & beyond_near).all(axis=1)
+    return hidden
+
+
+def _box_corners(model: mujoco.MjModel, data: mujoco.MjData, geoms: np.ndarray) -> np.ndarray:
+    """(n, 8, 3) world corners of the bounding boxes (`geom_aabb`, in each geom's frame) of `geoms`."""
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+    local = model.geom_aabb[geoms, None, :3] + signs * model.geom_aabb[geoms, None, 3:]
+    rotations = data.geom_xmat[geoms].reshape(-1, 3, 3)
+    return data.geom_xpos[geoms, None, :] + local @ rotations.transpose(0, 2, 1)
 
 
 def _frustum_planes(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspect: float,
