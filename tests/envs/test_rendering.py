@@ -8,7 +8,7 @@ import pytest
 from lerobot_tavis import canonical
 from lerobot_tavis.envs import physics, scene
 from lerobot_tavis.envs.env import TavisEnv
-from lerobot_tavis.envs.rendering import CameraRig, hidden_by_table, out_of_view
+from lerobot_tavis.envs.rendering import CameraRig, TableCover, out_of_view
 from tests.conftest import run_steps
 
 SIZE = (48, 64)
@@ -73,14 +73,19 @@ def test_the_table_top_hides_what_stands_under_it_only_from_above():
     env = TavisEnv("tabletop", "gr1t2", image_size=SIZE, cameras=())
     env.reset(seed=0)
     model, data = env.model, env.data
-    fixed = env.world.cameras[scene.FIXED_CAMERA]
-    names = {model.geom(g).name for g in np.flatnonzero(hidden_by_table(model, data, fixed))}
+    fixed, table = env.world.cameras[scene.FIXED_CAMERA], TableCover.of(model)
+    names = {model.geom(g).name for g in np.flatnonzero(table.hides(model, data, fixed))}
     assert "table/leg4" in names  # the middle back leg, far under the top
     assert not names & set(scene.TABLE_TOP_GEOMS)
-    assert names <= {model.geom(g).name for g in np.flatnonzero(out_of_view(model, data, fixed, SIZE[1] / SIZE[0]))}
+    unseen = out_of_view(model, data, fixed, SIZE[1] / SIZE[0], table=table)
+    assert names <= {model.geom(g).name for g in np.flatnonzero(unseen)}
     data.cam_xpos[fixed][2] = scene.TABLE_TOP_Z - 0.1  # below the top: it hides nothing
-    assert not hidden_by_table(model, data, fixed).any()
+    assert not table.hides(model, data, fixed).any()
     env.close()
+    shelves = TavisEnv("multi_shelf_scan", "gr1t2", image_size=SIZE, cameras=())
+    shelves.reset(seed=0)
+    assert TableCover.of(shelves.model) is None  # a task without the table
+    shelves.close()
 
 
 def test_a_wrist_camera_sees_the_backdrop_colour_beyond_its_far_clip():
