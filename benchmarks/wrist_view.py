@@ -1,6 +1,7 @@
 """Where the wrist cameras look with the arms at rest: pitch, position and what fills the image, per robot and side.
 
     MUJOCO_GL=egl python benchmarks/wrist_view.py [--robots gr1t2 reachy2] [--before CHECKOUT --image PNG]
+                                                  [--demo-episodes N]
 
 clutter_pick_cube, seed 0: reset, then the rest action (canonical.rest_action) for REST_STEPS steps. For each wrist
 camera, the pitch of its optical axis below the horizon (deg), its world position (m), and the share of its
@@ -9,6 +10,11 @@ camera, the pitch of its optical axis below the horizon (deg), its world positio
 
 With `--before`, the same measurement also runs on that checkout (an older commit), and `--image` writes GR1T2's
 left wrist view at rest before and after, side by side.
+
+With `--demo-episodes N` (this checkout only), also the wrist cameras through N demonstrator episodes of the same
+task (seeds 0..N-1, at most DEMO_STEPS steps each, every DEMO_EVERY-th step, both wrists): the pitch below the
+horizon (median, 10th and 90th percentiles; negative = above) and the share of frames whose image is more than
+10% table.
 """
 
 from __future__ import annotations
@@ -26,6 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 TASK, SEED, REST_STEPS = "clutter_pick_cube", 0, 30
 IMAGE_SIZE = (180, 240)
 SIDES = ("left", "right")
+DEMO_STEPS, DEMO_EVERY = 400, 10
 
 # Runs inside either checkout; uses only the API both share (TavisEnv with `cameras=`, canonical.rest_action).
 _MEASURE = """
@@ -74,11 +81,47 @@ def measure(tree: Path, robots: list[str], image_out: Path | None) -> list[dict]
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
+def demo_views(robot: str, episodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pitch below the horizon (deg) and table share of each sampled wrist frame through the demonstrations."""
+    import mujoco
+
+    from lerobot_tavis.envs.env import TavisEnv
+    from lerobot_tavis.experts.registry import make_expert
+
+    cameras = tuple(f"{side}_wrist" for side in SIDES)
+    env = TavisEnv(TASK, robot, image_size=IMAGE_SIZE, cameras=cameras)
+    pitches, shares = [], []
+    for seed in range(episodes):
+        env.reset(seed=seed)
+        expert = make_expert(env, seed)
+        expert.reset()
+        model, data = env.model, env.data
+        table = [g for g in range(model.ngeom) if model.geom(g).name.startswith("table/")]
+        with mujoco.Renderer(model, *IMAGE_SIZE) as renderer:
+            renderer.enable_segmentation_rendering()
+            for step in range(DEMO_STEPS):
+                _, _, terminated, truncated, _ = env.step(expert.act())
+                if step % DEMO_EVERY == 0:
+                    for camera in cameras:
+                        cam = env.world.cameras[camera]
+                        forward = -data.cam_xmat[cam].reshape(3, 3)[:, 2]
+                        renderer.update_scene(data, camera=cam)
+                        seg = renderer.render()
+                        geom = np.where(seg[..., 1] == mujoco.mjtObj.mjOBJ_GEOM, seg[..., 0], -1)
+                        pitches.append(np.degrees(-np.arcsin(forward[2])))
+                        shares.append(np.isin(geom, table).mean())
+                if terminated or truncated:
+                    break
+    env.close()
+    return np.array(pitches), np.array(shares)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--robots", nargs="+", default=["gr1t2", "reachy2"])
     parser.add_argument("--before", type=Path, help="a checkout of an older commit, measured too")
     parser.add_argument("--image", type=Path, help="with --before: write GR1T2's left wrist view before | after")
+    parser.add_argument("--demo-episodes", type=int, default=0, help="also measure through N demonstrations")
     args = parser.parse_args()
     if args.image and not args.before:
         parser.error("--image needs --before")
@@ -104,6 +147,14 @@ def main() -> None:
     if args.image:
         panels = [label(views[name], f"{name}: GR1T2 left wrist at rest") for name, _ in trees]
         print(write_png(args.image, np.concatenate(panels, axis=1)))
+    if args.demo_episodes:
+        print(f"\n{TASK}, {args.demo_episodes} demonstrations, both wrists every {DEMO_EVERY} steps:\n")
+        print("| robot | frames | pitch below horizon (deg): median [p10, p90] | frames > 10% table |")
+        print("|---|---|---|---|")
+        for robot in args.robots:
+            pitch, share = demo_views(robot, args.demo_episodes)
+            print(f"| {robot} | {len(pitch)} | {np.median(pitch):.1f} [{np.percentile(pitch, 10):.1f}, "
+                  f"{np.percentile(pitch, 90):.1f}] | {(share > 0.1).mean():.0%} |")
 
 
 if __name__ == "__main__":

@@ -2,18 +2,21 @@
 
 Each image draws only the geoms that can show in it or shadow what does (`out_of_view`): MuJoCo draws every geom in
 every pass, and with shadows each image takes three (the lit scene, the shadow map, the shadowed light), so a
-camera that sees a part of the scene saves most of its cost. The pixels are those of drawing everything.
+camera that sees a part of the scene saves most of its cost. Besides what lies outside the view, what stands under
+the table top where the top hides it is left out (`TableCover`): MuJoCo draws a covered geom in every pass too.
+The pixels are those of drawing everything.
 """
 
 from __future__ import annotations
 
 import os
 from contextlib import contextmanager
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-from lerobot_tavis.envs import physics
+from lerobot_tavis.envs import physics, scene
 from lerobot_tavis.envs.modes import WRIST_CAMERAS
 from lerobot_tavis.errors import TavisError
 
@@ -34,6 +37,7 @@ class CameraRig:
         self.blacked_out = blacked_out
         self._model = model
         self._renderer = None
+        self._table = TableCover.of(model)
         self._wrists = {camera for camera in range(model.ncam) if model.camera(camera).name.endswith(WRIST_CAMERAS)}
         if set(cameras) - set(blacked_out):
             self._ensure_renderer()  # else nothing to draw: no GL context until `render_camera` needs one
@@ -53,7 +57,7 @@ class CameraRig:
         renderer = self._ensure_renderer()
         wrist = camera_id in self._wrists
         unseen = out_of_view(self._model, data, camera_id, self.width / self.height,
-                             far_m=physics.WRIST_FAR_CLIP_M if wrist else None)
+                             far_m=physics.WRIST_FAR_CLIP_M if wrist else None, table=self._table)
         with _left_out(self._model, unseen):
             renderer.update_scene(data, camera=camera_id)
         renderer.scene.flags[mujoco.mjtRndFlag.mjRND_FOG] = wrist
@@ -78,13 +82,14 @@ class CameraRig:
 
 
 def out_of_view(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspect: float,
-                far_m: float | None = None) -> np.ndarray:
+                far_m: float | None = None, table: TableCover | None = None) -> np.ndarray:
     """(ngeom,) bool: the geoms that can neither appear in the image of camera `camera_id` (`aspect` = width /
     height) nor shadow anything that does, judged by their bounding spheres (`geom_rbound`). With `far_m`, what lies
     farther than `far_m` (m, along the view) counts as unseen too (a wrist camera's fog covers it).
 
     A shadow-casting geom is kept while the capsule swept by its sphere along a casting directional light, down to
     the floor (z = 0, below which nothing is drawn), reaches into the view: a shadow it casts falls within it.
+    With `table`, the geoms under the table top that it hides and that cast no shadow count as unseen too.
     Planes (unbounded) are always kept; so is every geom when the camera is not a plain perspective one, or when a
     light that is not directional casts shadows. The near plane culls; MuJoCo's far plane does not.
     """
@@ -105,7 +110,57 @@ def out_of_view(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspe
         reach = (np.maximum(centres[:, 2], 0.0) + radii) / -direction[2]
         swept_out = (outside & _outside(planes, centres + reach[:, None] * direction, radii)).any(axis=1)
         hidden &= ~casts | swept_out
+    if table is not None:
+        hidden |= table.hides(model, data, camera_id) & ~casts
     return hidden & (radii > 0)
+
+
+@dataclass(frozen=True)
+class TableCover:
+    """The table's drawn top surface (`scene.TABLE_SURFACE`, an axis-aligned plane: `centre` (m, world) and
+    `half` sizes (m) along x and y) and the table's geoms that stand wholly under it (legs, shelf, bins): `geoms`
+    and the world corners of their bounding boxes, `corners` (n, 8, 3). The table is static, so this holds for the
+    model's lifetime."""
+
+    centre: np.ndarray
+    half: np.ndarray
+    geoms: np.ndarray
+    corners: np.ndarray
+
+    @classmethod
+    def of(cls, model: mujoco.MjModel) -> TableCover | None:
+        """The model's table cover; None when the model has no table."""
+        surface = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, scene.TABLE_SURFACE)
+        if surface < 0:
+            return None
+        data = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, data)
+        centre, half = data.geom_xpos[surface].copy(), model.geom_size[surface][:2].copy()
+        table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, scene.TABLE_BODY)
+        top = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name) for name in scene.TABLE_TOP_GEOMS]
+        geoms = np.setdiff1d(np.flatnonzero(model.geom_bodyid == table), top)
+        signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+        local = model.geom_aabb[geoms, None, :3] + signs * model.geom_aabb[geoms, None, 3:]  # in each geom's frame
+        rotations = data.geom_xmat[geoms].reshape(-1, 3, 3)
+        corners = data.geom_xpos[geoms, None, :] + local @ rotations.transpose(0, 2, 1)
+        below = (corners[..., 2] < centre[2]).all(axis=1)
+        return cls(centre, half, geoms[below], corners[below])
+
+    def hides(self, model: mujoco.MjModel, data: mujoco.MjData, camera_id: int) -> np.ndarray:
+        """(ngeom,) bool: the geoms under the top that it hides from camera `camera_id`: the camera is above the
+        surface and every line of sight to the geom's bounding box crosses the surface beyond the near clip plane
+        (the box's corners seen through the surface's plane all fall within the surface, which is convex)."""
+        hidden = np.zeros(model.ngeom, dtype=bool)
+        eye = data.cam_xpos[camera_id]
+        if eye[2] <= self.centre[2]:
+            return hidden
+        drop = eye[2] - self.corners[..., 2:3]
+        through = eye + (eye[2] - self.centre[2]) / drop * (self.corners - eye)  # on the surface's plane
+        forward = -data.cam_xmat[camera_id].reshape(3, 3)[:, 2]
+        within = (np.abs(through[..., :2] - self.centre[:2]) < self.half).all(axis=-1)
+        beyond_near = (through - eye) @ forward > model.vis.map.znear * model.stat.extent
+        hidden[self.geoms] = (within & beyond_near).all(axis=1)
+        return hidden
 
 
 def _frustum_planes(model: mujoco.MjModel, data: mujoco.MjData, camera_id: int, aspect: float,

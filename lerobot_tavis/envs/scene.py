@@ -41,7 +41,9 @@ BIN_SHELF_Z = 0.60  # the shelf's top face; bins stand on it just behind the fro
 BIN_SIZE_M = (0.35, 0.42, 0.20)  # depth (x), width (y), height (z)
 BIN_GAP_M = 0.04
 BIN_FRONT_X = 0.25
-TABLE_TOP_GEOMS = ("table/top", "table/lip", "table/surface")  # drawn with TABLE_TOP_LOOK (ood_visual varies it)
+TABLE_BODY = "table"
+TABLE_SLAB, TABLE_LIP, TABLE_SURFACE = "table/top", "table/lip", "table/surface"
+TABLE_TOP_GEOMS = (TABLE_SLAB, TABLE_LIP, TABLE_SURFACE)  # drawn with TABLE_TOP_LOOK (ood_visual varies it)
 TABLE_SURFACE_GRID_M = 0.05  # tessellation of the drawn table top (m)
 TABLE_SURFACE_LIFT_M = 0.0005  # the drawn top lies this far above the collision box's top face
 FLOOR_GRID_M = 0.5  # tessellation of the drawn floor (m)
@@ -144,23 +146,23 @@ def add_table(spec: mujoco.MjSpec) -> None:
     The top and the lip collide; legs, shelf and bins are drawn only (nothing reaches under the table) and cast no
     shadow (they stand in the top's shadow).
     """
-    table = spec.worldbody.add_body(name="table")
+    table = spec.worldbody.add_body(name=TABLE_BODY)
     lip = TABLE_LIP_RADIUS_M
     x0, x1 = TABLE_X[0] + lip, TABLE_X[1]  # the flat top; the lip rounds off its front
     y0, y1 = TABLE_Y
     cx, cy, hx, hy = (x0 + x1) / 2, (y0 + y1) / 2, (x1 - x0) / 2, (y1 - y0) / 2
-    top = table.add_geom(name="table/top", type=mujoco.mjtGeom.mjGEOM_BOX)
+    top = table.add_geom(name=TABLE_SLAB, type=mujoco.mjtGeom.mjGEOM_BOX)
     top.size = (hx, hy, TABLE_THICKNESS / 2)
     top.pos = (cx, cy, TABLE_TOP_Z - TABLE_THICKNESS / 2)
     physics.style_geom(top, physics.STATIC)
     use_look(spec, top, TABLE_TOP_LOOK)
-    front = table.add_geom(name="table/lip", type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+    front = table.add_geom(name=TABLE_LIP, type=mujoco.mjtGeom.mjGEOM_CAPSULE,
                            fromto=(x0, y0 + lip, TABLE_TOP_Z - lip, x0, y1 - lip, TABLE_TOP_Z - lip), size=(lip, 0, 0))
     physics.style_geom(front, physics.STATIC)
     use_look(spec, front, TABLE_TOP_LOOK)
     # The top face drawn again as a finely tessellated plane just above it: MuJoCo lights per vertex, and a box
     # face's few vertices would turn the key light's soft highlight into blotches.
-    surface = table.add_geom(name="table/surface", type=mujoco.mjtGeom.mjGEOM_PLANE)
+    surface = table.add_geom(name=TABLE_SURFACE, type=mujoco.mjtGeom.mjGEOM_PLANE)
     surface.size = (hx, hy, TABLE_SURFACE_GRID_M)
     surface.pos = (cx, cy, TABLE_TOP_Z + TABLE_SURFACE_LIFT_M)
     physics.style_geom(surface, physics.VISUAL)

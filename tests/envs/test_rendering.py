@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from lerobot_tavis import canonical
-from lerobot_tavis.envs import physics
+from lerobot_tavis.envs import physics, scene
 from lerobot_tavis.envs.env import TavisEnv
-from lerobot_tavis.envs.rendering import CameraRig, out_of_view
+from lerobot_tavis.envs.rendering import CameraRig, TableCover, out_of_view
 from tests.conftest import run_steps
 
 SIZE = (48, 64)
@@ -67,6 +67,25 @@ def test_a_wrist_camera_leaves_out_most_of_the_robot_but_not_what_shadows_its_vi
     model.geom_castshadow[can] = 0
     assert out_of_view(model, data, head_view, SIZE[1] / SIZE[0])[can]
     env.close()
+
+
+def test_the_table_top_hides_what_stands_under_it_only_from_above():
+    env = TavisEnv("tabletop", "gr1t2", image_size=SIZE, cameras=())
+    env.reset(seed=0)
+    model, data = env.model, env.data
+    fixed, table = env.world.cameras[scene.FIXED_CAMERA], TableCover.of(model)
+    names = {model.geom(g).name for g in np.flatnonzero(table.hides(model, data, fixed))}
+    assert "table/leg4" in names  # the middle back leg, far under the top
+    assert not names & set(scene.TABLE_TOP_GEOMS)
+    unseen = out_of_view(model, data, fixed, SIZE[1] / SIZE[0], table=table)
+    assert names <= {model.geom(g).name for g in np.flatnonzero(unseen)}
+    data.cam_xpos[fixed][2] = scene.TABLE_TOP_Z - 0.1  # below the top: it hides nothing
+    assert not table.hides(model, data, fixed).any()
+    env.close()
+    shelves = TavisEnv("multi_shelf_scan", "gr1t2", image_size=SIZE, cameras=())
+    shelves.reset(seed=0)
+    assert TableCover.of(shelves.model) is None  # a task without the table
+    shelves.close()
 
 
 def test_a_wrist_camera_sees_the_backdrop_colour_beyond_its_far_clip():
