@@ -86,7 +86,7 @@ def demo_views(robot: str, episodes: int) -> tuple[np.ndarray, np.ndarray]:
     import mujoco
 
     from lerobot_tavis.envs.env import TavisEnv
-    from lerobot_tavis.experts.registry import make_expert
+    from lerobot_tavis.experts.rollout import make_expert
 
     cameras = tuple(f"{side}_wrist" for side in SIDES)
     env = TavisEnv(TASK, robot, image_size=IMAGE_SIZE, cameras=cameras)
