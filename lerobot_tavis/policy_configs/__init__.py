@@ -43,10 +43,10 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from lerobot_tavis import canonical
+from lerobot_tavis.envs.checkpoint_settings import UNRESIZED_POLICIES
 from lerobot_tavis.envs.modes import (BUILTIN_CAMERA_MODES, RENAMED_MODES, mode_cameras, neck_locked,
                                       resolve_camera_mode)
 from lerobot_tavis.errors import InputError
-from lerobot_tavis.envs.checkpoint_settings import UNRESIZED_POLICIES
 from lerobot_tavis.policies.dataset_fit import check_dataset_images
 from lerobot_tavis.readers import read_json
 
@@ -203,9 +203,9 @@ def refuse_unfit_training_dataset(args: Sequence[str]) -> None:
         config = json.loads(Path(config_path).read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError):
         return
-    env_type = parse_arg("env.type", args) or ((config.get("env") or {}).get("type") if isinstance(config, dict)
-                                              else None)
-    if env_type != "tavis":
+    if not isinstance(config, dict):
+        return
+    if (parse_arg("env.type", args) or (config.get("env") or {}).get("type")) != "tavis":
         return
     try:
         check_training_dataset(Path(config_path), args)
