@@ -19,6 +19,12 @@ setup: $(STAMP)
 
 $(STAMP): pyproject.toml
 	@test -n "$(PYTHON)" || { echo "Python 3.12 not found: install it or pass PYTHON=/path/to/python3.12"; exit 1; }
+ifeq ($(CPU),1)
+	@$(PYTHON) -c "import urllib.request; urllib.request.urlopen('$(TORCH_CPU_INDEX)/torch/', timeout=30).read(1)" \
+		2>/dev/null || { echo "make setup CPU=1: PyTorch's CPU wheel index $(TORCH_CPU_INDEX) cannot be reached" \
+			"from here (PyPI has no CPU-only torch for Linux): run make setup without CPU=1 (PyPI's CUDA build runs" \
+			"on a CPU as well)"; exit 1; }
+endif
 	@$(MAKE) --no-print-directory system-deps
 	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --upgrade pip

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import re
 import types
 import typing
 from collections.abc import Callable, Sequence
@@ -131,6 +132,10 @@ class CommandParser(argparse.ArgumentParser):
         return super().parse_known_args(args, namespace)
 
 
+# A help text that states its option's default: "default: <what>" or "default <value>" (not "LeRobot's default,").
+STATES_DEFAULT = re.compile(r"\bdefault:?\s")
+
+
 def _help(field: dataclasses.Field, settings: OptionSpec) -> str | None:
     """The option's help text, ending with "(default: <value>)" when the field has a default the text does not state
     and that reads as typed on the command line: off for a switch, a number, a word, a path, a list of them."""
@@ -141,7 +146,7 @@ def _help(field: dataclasses.Field, settings: OptionSpec) -> str | None:
         default = field.default_factory()
     else:
         return text
-    if (text and "default" in text) or settings.parse is not None or default is None or default == ():
+    if (text and STATES_DEFAULT.search(text)) or settings.parse is not None or default is None or default == ():
         return text
     if default is False:
         shown = "off"

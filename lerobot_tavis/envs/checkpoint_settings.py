@@ -6,8 +6,9 @@ reads, and their size, in `config.json` (`input_features`: `observation.images.<
 lerobot-train made it with `--env.type=tavis`, `train_config.json` beside it holds that env's robot, camera mode and
 image size. `match_settings` settles an evaluation's env: a setting the user gave is kept (with a warning where it
 differs from the checkpoint's), one left out takes the checkpoint's; a camera the policy reads that the camera mode
-does not render is refused, naming the camera mode that renders the policy's cameras. Only JSON is read here: no
-torch, no LeRobot.
+does not render is refused, naming the camera mode that renders the policy's cameras, and so is an image size other
+than the checkpoint's for a policy that does not resize its images (UNRESIZED_POLICIES: its network would see images
+of a size it never trained on). Only JSON is read here: no torch, no LeRobot.
 """
 
 from __future__ import annotations
@@ -25,17 +26,20 @@ POLICY_CONFIG_NAME = "config.json"
 TRAIN_CONFIG_NAME = "train_config.json"
 IMAGE_PREFIX = "observation.images."
 SETTINGS = ("robot", "camera_mode", "image_size")  # the env settings a checkpoint fixes
+UNRESIZED_POLICIES = ("act", "act_hand_relative")  # policy types whose network reads the frames at their size
 
 
 @dataclass(frozen=True)
 class CheckpointSettings:
     """What a checkpoint says of its env; None where it says nothing. `cameras`: those its network reads, in the
-    order of its `input_features`; `image_size`: their common (height, width), pixels."""
+    order of its `input_features`; `image_size`: their common (height, width), pixels; `policy_type`: its config's
+    `type` (e.g. act, diffusion)."""
 
     robot: str | None = None
     camera_mode: str | None = None
     cameras: tuple[str, ...] | None = None
     image_size: tuple[int, int] | None = None
+    policy_type: str | None = None
 
     def known(self) -> dict:
         """The env settings (robot, camera_mode, image_size) the checkpoint fixes."""
@@ -44,7 +48,8 @@ class CheckpointSettings:
 
 def settings_from_configs(policy: dict | None, train: dict | None) -> CheckpointSettings:
     """The settings in a checkpoint's `config.json` (`policy`) and `train_config.json` (`train`), as parsed JSON."""
-    features = (policy or {}).get("input_features") or ((train or {}).get("policy") or {}).get("input_features") or {}
+    policy = policy or (train or {}).get("policy") or {}
+    features = policy.get("input_features") or ((train or {}).get("policy") or {}).get("input_features") or {}
     images = {key.removeprefix(IMAGE_PREFIX): tuple(feature.get("shape", ()))
               for key, feature in features.items() if key.startswith(IMAGE_PREFIX)}
     env = (train or {}).get("env") or {}
@@ -54,7 +59,7 @@ def settings_from_configs(policy: dict | None, train: dict | None) -> Checkpoint
     cameras = tuple(images) or None
     camera_mode = RENAMED_MODES.get(env.get("camera_mode"), env.get("camera_mode"))
     camera_mode = camera_mode if camera_mode in CAMERA_MODES else _mode_of(cameras)
-    return CheckpointSettings(env.get("robot"), camera_mode, cameras, image_size)
+    return CheckpointSettings(env.get("robot"), camera_mode, cameras, image_size, policy.get("type"))
 
 
 def read_checkpoint_settings(policy_path: str | Path, download: bool = False) -> CheckpointSettings:
@@ -78,9 +83,15 @@ def match_settings(checkpoint: CheckpointSettings, given: dict, defaults: dict,
 
     `given`: the settings the user chose (name -> value); `defaults`: the value of each of SETTINGS when neither the
     user nor the checkpoint gives one; `spell(name)`: how the user writes the option (e.g. `--env.image_size`).
-    Raises InputError when the camera mode does not render every camera the policy reads."""
+    Raises InputError when the camera mode does not render every camera the policy reads, or when the image size
+    differs from the checkpoint's and its policy does not resize its images."""
     settings = {name: given.get(name, checkpoint.known().get(name, defaults[name])) for name in SETTINGS}
     settings["image_size"] = tuple(settings["image_size"])
+    trained, asked = checkpoint.image_size, settings["image_size"]
+    if checkpoint.policy_type in UNRESIZED_POLICIES and trained is not None and asked != tuple(trained):
+        raise InputError(f"the policy ({checkpoint.policy_type}, which does not resize its images) was trained on "
+                         f"{_size(trained)} images, {spell('image_size')} asks for {_size(asked)}: leave "
+                         f"{spell('image_size')} out to use the checkpoint's")
     rendered = mode_cameras(settings["camera_mode"])
     policy_cameras = checkpoint.cameras
     if policy_cameras and not set(policy_cameras) <= set(rendered):

@@ -111,7 +111,7 @@ class ProtocolConfig:
                                 "films 10): a filming job holds about 1 GB of frames per filmed episode at 20 s")
     backend: str = option("local", "local processes, or a Ray cluster (RAY_ADDRESS; docs/scaling.md)",
                           choices=BACKENDS)
-    seed: int = option(START_SEED, "first episode seed (lerobot-eval's default)")
+    seed: int = option(START_SEED, "first episode seed, as lerobot-eval's first")
     out_dir: Path = option(help="output directory; a re-run with the same settings resumes it, skipping finished "
                            "cells and chunks", flag="--out")
     restart: bool = option(False, "play again the cells of --out that were played with other settings (default: "

@@ -8,10 +8,8 @@ neither the size nor, when the dataset has fewer cameras than the policy, the ca
 
 from __future__ import annotations
 
+from lerobot_tavis.envs.checkpoint_settings import IMAGE_PREFIX
 from lerobot_tavis.errors import InputError
-
-IMAGE_PREFIX = "observation.images."
-UNRESIZED_POLICIES = ("act", "act_hand_relative")  # policies that feed the frames to their network at their size
 
 
 def check_dataset_images(input_features: dict, dataset_features: dict, resizes: bool) -> None:

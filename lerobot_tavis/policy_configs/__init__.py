@@ -34,7 +34,9 @@ TAVIS. Override anything on the command line (`--dataset.repo_id=... --dataset.r
   are executed, UNet 256-512-1024, 10 DDIM steps when acting, `observation.state` read as the anchor alone.
 
 `tavis train` checks a local dataset against the preset first (`check_training_dataset`): the cameras the policy
-reads must be there and, for ACT (which does not resize its images), at the preset's size.
+reads must be there and, for ACT (which does not resize its images), at the preset's size. A plain
+`lerobot-train --config_path=<preset>` makes the same check when it imports the plugin
+(`refuse_unfit_training_dataset`).
 
 The JSON files are generated from `build_preset` (`python -m lerobot_tavis.policy_configs` rewrites them); a test
 keeps the two in step.
@@ -47,10 +49,11 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from lerobot_tavis import canonical
+from lerobot_tavis.envs.checkpoint_settings import UNRESIZED_POLICIES
 from lerobot_tavis.envs.modes import (BUILTIN_CAMERA_MODES, RENAMED_MODES, mode_cameras, neck_locked,
                                       resolve_camera_mode)
 from lerobot_tavis.errors import InputError
-from lerobot_tavis.policies.dataset_fit import UNRESIZED_POLICIES, check_dataset_images
+from lerobot_tavis.policies.dataset_fit import check_dataset_images
 from lerobot_tavis.readers import read_json
 
 PRESET_DIR = Path(__file__).parent
@@ -204,9 +207,35 @@ def check_training_dataset(preset: Path, lerobot_args: Sequence[str]) -> None:
     features = content.get("features") if isinstance(content, dict) else None
     if not isinstance(features, dict):
         raise InputError(f"{info}: not a LeRobotDataset's info.json (no features object)")
-    policy_type = parse_arg("policy.type", lerobot_args) or config["policy"]["type"]
-    check_dataset_images(config["policy"].get("input_features", {}), features,
-                         resizes=policy_type not in UNRESIZED_POLICIES)
+    policy = config.get("policy") or {}
+    policy_type = parse_arg("policy.type", lerobot_args) or policy.get("type")
+    check_dataset_images(policy.get("input_features") or {}, features, resizes=policy_type not in UNRESIZED_POLICIES)
+
+
+def refuse_unfit_training_dataset(args: Sequence[str]) -> None:
+    """`check_training_dataset` for lerobot-train's own command line `args` when its `--config_path` is a TAVIS
+    training config (a preset, or a train_config.json whose env is `tavis`): an unfit dataset ends the process with
+    one line (SystemExit) before LeRobot loads anything. LeRobot 0.6.1 hands no plugin its dataset's metadata
+    before training (a policy config gets it through `set_dataset_feature_metadata`, which its own ACT and
+    Diffusion configs lack), so the plugin reads the command line as lerobot-train will. A config that is not a
+    readable JSON file is left to LeRobot to report."""
+    from lerobot.configs.parser import parse_arg
+
+    config_path = parse_arg("config_path", args)
+    if not config_path or not Path(config_path).is_file():
+        return
+    try:
+        config = json.loads(Path(config_path).read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return
+    if not isinstance(config, dict):
+        return
+    if (parse_arg("env.type", args) or (config.get("env") or {}).get("type")) != "tavis":
+        return
+    try:
+        check_training_dataset(Path(config_path), args)
+    except InputError as error:
+        raise SystemExit(f"lerobot-train: error: {error}") from None
 
 
 def missing_pi0_downloads() -> list[str]:

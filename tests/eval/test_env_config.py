@@ -260,13 +260,14 @@ def test_an_explicit_episode_log_wins_and_without_either_there_is_none(tmp_path,
     assert "no episode log" in caplog.text and "--env.episode_log" in caplog.text
 
 
-def _checkpoint(path, cameras=("head", "left_wrist", "right_wrist"), image_size=(120, 160), env=None):
-    """A checkpoint's config files (no weights): its policy reads `cameras` at `image_size`."""
+def _checkpoint(path, cameras=("head", "left_wrist", "right_wrist"), image_size=(120, 160), env=None,
+                policy_type="act"):
+    """A checkpoint's config files (no weights): its `policy_type` policy reads `cameras` at `image_size`."""
     import json
 
     path.mkdir(parents=True)
     images = {f"observation.images.{camera}": {"type": "VISUAL", "shape": [3, *image_size]} for camera in cameras}
-    (path / "config.json").write_text(json.dumps({"type": "act", "input_features": images}))
+    (path / "config.json").write_text(json.dumps({"type": policy_type, "input_features": images}))
     if env is not None:
         (path / "train_config.json").write_text(json.dumps({"env": env}))
     return str(path)
@@ -285,13 +286,22 @@ def test_lerobot_eval_renders_what_the_policy_of_its_command_line_reads(tmp_path
 
 
 def test_a_setting_given_to_lerobot_eval_wins_with_a_warning(tmp_path, caplog):
-    checkpoint = _checkpoint(tmp_path / "ckpt")
+    checkpoint = _checkpoint(tmp_path / "ckpt", policy_type="diffusion")  # resizes its images itself
     config = TavisEnvConfig(task="wait_then_act", image_size=(480, 640))  # the default, but on the command line
     with caplog.at_level("WARNING"):
         config.match_command_line_policy([f"--policy.path={checkpoint}", "--env.image_size=[480, 640]"])
     assert tuple(config.image_size) == (480, 640)
     assert ("the policy was trained on 120x160 images; --env.image_size asks for 480x640 (leave --env.image_size "
             "out to use the checkpoint's)") in caplog.text
+
+
+def test_lerobot_eval_refuses_another_image_size_for_a_policy_that_does_not_resize(tmp_path):
+    checkpoint = _checkpoint(tmp_path / "ckpt", policy_type="act")
+    config = TavisEnvConfig(task="wait_then_act", image_size=(96, 128))
+    with pytest.raises(ValueError, match=r"^the policy \(act, which does not resize its images\) was trained on "
+                                         "120x160 images, --env.image_size asks for 96x128: leave --env.image_size "
+                                         "out to use the checkpoint's$"):
+        config.match_command_line_policy([f"--policy.path={checkpoint}"])
 
 
 def test_lerobot_eval_refuses_a_camera_mode_without_the_policys_cameras(tmp_path):

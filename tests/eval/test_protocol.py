@@ -151,6 +151,17 @@ def test_tavis_eval_of_a_hub_policy_fetches_its_settings(tmp_path, monkeypatch):
     assert fetched == [("someone/act", "config.json"), ("someone/act", "train_config.json")]
 
 
+def test_tavis_eval_refuses_another_image_size_for_an_act_checkpoint(tmp_path):
+    checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {"type": "tavis"}, cameras=("head",))
+    config = json.loads((checkpoint / "config.json").read_text())
+    (checkpoint / "config.json").write_text(json.dumps(config | {"type": "act"}))
+    with pytest.raises(SystemExit, match=r"^tavis eval: error: the policy \(act, which does not resize its images\) "
+                                         "was trained on 120x160 images, --image-size asks for 96x128: leave "
+                                         "--image-size out to use the checkpoint's$"):
+        main(["eval", "--policy", str(checkpoint), "--out", str(tmp_path / "out"), "--image-size", "96x128"])
+    assert not (tmp_path / "out").exists()
+
+
 def test_tavis_eval_refuses_a_camera_mode_without_the_policys_cameras(tmp_path):
     checkpoint = _trained_checkpoint(tmp_path / "pretrained_model", {"type": "tavis", "camera_mode": "fixed_wrist"},
                                      cameras=("fixed", "left_wrist", "right_wrist"))
