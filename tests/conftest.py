@@ -1,4 +1,6 @@
+import fcntl
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -56,3 +58,44 @@ def benchmark_script(monkeypatch):
         return module
 
     return load
+
+
+def built_once_per_run(tmp_path_factory, name: str, build) -> Path:
+    """`build(path)` run once per test run, however many pytest-xdist workers ask for `name`: the first to take the
+    lock builds it in the run's temporary root, the others wait and reuse it. Tests must only read what it holds
+    (damage copies)."""
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent  # the folder the workers' own temporary roots share
+    path, done = root / name, root / f"{name}.done"
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.exists():
+            shutil.rmtree(path, ignore_errors=True)  # what a failed attempt left
+            build(path)
+            done.touch()
+    return path
+
+
+@pytest.fixture(scope="session")
+def conditional_pick_raw(tmp_path_factory) -> Path:
+    """`tavis record` of two conditional_pick demonstrations (GR1T2, seeds from 100000), recorded once per run."""
+    from lerobot_tavis.dataset_tools.record import RecordConfig, record
+
+    def build(path):
+        record(RecordConfig(out_dir=path, robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=2),
+               progress=False)
+
+    return built_once_per_run(tmp_path_factory, "conditional_pick_raw", build)
+
+
+@pytest.fixture(scope="session")
+def conditional_pick_dataset(conditional_pick_raw, tmp_path_factory) -> Path:
+    """The two demonstrations converted once per run: 20 Hz, the head camera only, 48x64 AV1 video."""
+    from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+
+    def build(path):
+        convert(ConvertConfig(conditional_pick_raw, "local/conditional_pick", path, image_size=(48, 64),
+                              cameras=("head",)), progress=False)
+
+    return built_once_per_run(tmp_path_factory, "conditional_pick_dataset", build)
