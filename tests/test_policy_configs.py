@@ -17,6 +17,8 @@ from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
 from lerobot_tavis.dataset_tools.record import RecordConfig, record
 from lerobot_tavis.policy_configs import build_preset, preset_names, preset_path, presets
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 TINY = (48, 64)
 # Small enough for a CPU: the preset's network shrunk, 1-second episodes, two denoising steps.
 SMALL_RUN = ["--env.task=conditional_pick", f"--env.image_size=[{TINY[0]},{TINY[1]}]", "--env.episode_length_s=1",

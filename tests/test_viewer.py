@@ -14,6 +14,8 @@ import pytest
 
 from lerobot_tavis.viewer import NoDisplayError, ViewConfig, view
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 PLAY = """
 import json, time
 from lerobot_tavis.viewer import ViewConfig, view

@@ -17,6 +17,8 @@ from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
 from lerobot_tavis.dataset_tools.frame_cache import FrameCache, StaleFrameCacheError, cache_dir
 from lerobot_tavis.policy_configs import preset_path
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 TINY = (48, 64)
 CAMERAS = ("head", "left_wrist", "right_wrist")
 CAMERA_KEYS = [f"observation.images.{camera}" for camera in CAMERAS]

@@ -13,6 +13,8 @@ from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
 from lerobot_tavis.dataset_tools.frame_cache import cache_dir
 from lerobot_tavis.policy_configs import preset_path
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 
 @pytest.fixture(scope="module")
 def dataset_root(conditional_pick_dataset, tmp_path_factory):
