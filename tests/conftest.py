@@ -84,16 +84,27 @@ def built_once_per_run(tmp_path_factory, name: str, build) -> Path:
     return path
 
 
-@pytest.fixture(scope="session")
-def conditional_pick_raw(tmp_path_factory) -> Path:
-    """`tavis record` of two conditional_pick demonstrations (GR1T2, seeds from 100000), recorded once per run."""
+def _conditional_pick_recording(tmp_path_factory, episodes: int) -> Path:
+    """`tavis record` of `episodes` conditional_pick demonstrations (GR1T2, seeds from 100000), once per run."""
     from lerobot_tavis.dataset_tools.record import RecordConfig, record
 
     def build(path):
-        record(RecordConfig(out_dir=path, robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=2),
+        record(RecordConfig(out_dir=path, robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=episodes),
                progress=False)
 
-    return built_once_per_run(tmp_path_factory, "conditional_pick_raw", build)
+    return built_once_per_run(tmp_path_factory, f"conditional_pick_raw_{episodes}", build)
+
+
+@pytest.fixture(scope="session")
+def conditional_pick_raw(tmp_path_factory) -> Path:
+    """Two conditional_pick demonstrations (GR1T2) in a `tavis record` directory."""
+    return _conditional_pick_recording(tmp_path_factory, 2)
+
+
+@pytest.fixture(scope="session")
+def conditional_pick_demonstration(tmp_path_factory) -> Path:
+    """One conditional_pick demonstration (GR1T2) in a `tavis record` directory."""
+    return _conditional_pick_recording(tmp_path_factory, 1)
 
 
 @pytest.fixture(scope="session")

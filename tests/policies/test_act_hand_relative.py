@@ -280,8 +280,8 @@ def test_a_checkpoint_keeps_the_statistics_and_lerobot_finds_the_policy_and_its_
     torch.testing.assert_close(processed[OBS_STATE], raw_state)  # the anchor reaches the policy un-normalised
 
 
-def test_chunks_planned_on_recorded_states_land_on_the_recorded_actions_when_anchored_on_the_env(tmp_path,
-                                                                                                 monkeypatch):
+def test_chunks_planned_on_recorded_states_land_on_the_recorded_actions_when_anchored_on_the_env(
+        conditional_pick_demonstration, tmp_path, monkeypatch):
     """The anchor a policy learns on (the dataset's observation.state) is the one it acts on (the env's agent_pos
     through LeRobot's observation conversion and the processors): an oracle network that plans every chunk from the
     recorded actions and states, executed by a checkpoint in `PolicyDriver`, repeats the demonstration."""
@@ -291,15 +291,12 @@ def test_chunks_planned_on_recorded_states_land_on_the_recorded_actions_when_anc
     from lerobot.policies.factory import make_pre_post_processors
 
     from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG, ConvertConfig, convert
-    from lerobot_tavis.dataset_tools.record import RecordConfig, record
     from lerobot_tavis.envs.env import TavisEnv
     from lerobot_tavis.viewer import PolicyDriver
 
     monkeypatch.setenv("MUJOCO_GL", "egl")
-    record(RecordConfig(out_dir=tmp_path / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
-           progress=False)
-    root = convert(ConvertConfig(tmp_path / "raw", "local/tiny", tmp_path / "dataset", image_size=(32, 32),
-                                 cameras=("head",)), progress=False)
+    root = convert(ConvertConfig(conditional_pick_demonstration, "local/tiny", tmp_path / "dataset",
+                                 image_size=(32, 32), cameras=("head",)), progress=False)
     (entry,) = json.loads((root / CONVERSION_LOG).read_text())["episodes"]
     frames = pd.read_parquet(next((root / "data").rglob("*.parquet"))).sort_values("frame_index")
     actions = torch.tensor(np.stack(frames["action"].to_numpy()), dtype=torch.float32)
