@@ -56,7 +56,7 @@ demo: $(STAMP)
 	$(VENV)/bin/tavis demo --out outputs/demo
 
 test: $(STAMP)
-	$(VENV)/bin/python -m pytest -n auto --dist loadfile -q
+	$(VENV)/bin/python -m pytest -n auto --dist loadfile --no-loadscope-reorder -q
 
 clean:
 	rm -rf $(VENV) outputs .pytest_cache

@@ -1,4 +1,6 @@
+import fcntl
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -10,6 +12,13 @@ import pytest  # noqa: E402
 from lerobot_tavis.envs.robots import BUILTIN_ROBOTS  # noqa: E402
 
 ROBOTS = BUILTIN_ROBOTS
+
+
+def pytest_collection_modifyitems(items):
+    """The files marked slow run first, each file's tests still together and in order: `make test` hands whole
+    files to its workers in this order (pytest-xdist's --dist loadfile --no-loadscope-reorder), so the run does not
+    end on one long file while the other workers sit idle."""
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
 @pytest.fixture(params=ROBOTS)
@@ -56,3 +65,55 @@ def benchmark_script(monkeypatch):
         return module
 
     return load
+
+
+def built_once_per_run(tmp_path_factory, name: str, build) -> Path:
+    """`build(path)` run once per test run, however many pytest-xdist workers ask for `name`: the first to take the
+    lock builds it in the run's temporary root, the others wait and reuse it. Tests must only read what it holds
+    (damage copies)."""
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent  # the folder the workers' own temporary roots share
+    path, done = root / name, root / f"{name}.done"
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.exists():
+            shutil.rmtree(path, ignore_errors=True)  # what a failed attempt left
+            build(path)
+            done.touch()
+    return path
+
+
+def _conditional_pick_recording(tmp_path_factory, episodes: int) -> Path:
+    """`tavis record` of `episodes` conditional_pick demonstrations (GR1T2, seeds from 100000), once per run."""
+    from lerobot_tavis.dataset_tools.record import RecordConfig, record
+
+    def build(path):
+        record(RecordConfig(out_dir=path, robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=episodes),
+               progress=False)
+
+    return built_once_per_run(tmp_path_factory, f"conditional_pick_raw_{episodes}", build)
+
+
+@pytest.fixture(scope="session")
+def conditional_pick_raw(tmp_path_factory) -> Path:
+    """Two conditional_pick demonstrations (GR1T2) in a `tavis record` directory."""
+    return _conditional_pick_recording(tmp_path_factory, 2)
+
+
+@pytest.fixture(scope="session")
+def conditional_pick_demonstration(tmp_path_factory) -> Path:
+    """One conditional_pick demonstration (GR1T2) in a `tavis record` directory."""
+    return _conditional_pick_recording(tmp_path_factory, 1)
+
+
+@pytest.fixture(scope="session")
+def conditional_pick_dataset(conditional_pick_raw, tmp_path_factory) -> Path:
+    """The two demonstrations converted once per run: 20 Hz, the head camera only, 48x64 AV1 video."""
+    from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
+
+    def build(path):
+        convert(ConvertConfig(conditional_pick_raw, "local/conditional_pick", path, image_size=(48, 64),
+                              cameras=("head",)), progress=False)
+
+    return built_once_per_run(tmp_path_factory, "conditional_pick_dataset", build)

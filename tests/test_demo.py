@@ -1,8 +1,11 @@
 import av
 import numpy as np
+import pytest
 
 from lerobot_tavis.demo import DemoConfig, run_demo
 from lerobot_tavis.overlay import EVENT_COLOURS, PANEL_HEIGHT, band_height
+
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
 
 def test_demo_writes_an_annotated_video_per_task(tmp_path):

@@ -15,6 +15,8 @@ from lerobot_tavis.experts.base import Hold, Move, play
 from lerobot_tavis.experts.rollout import make_expert, run_episode
 from lerobot_tavis.metrics.galt import compute_galt
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 TASKS = [task for suite in SUITES for task in suite_tasks(suite)]
 SUCCESS_X = SHELF_X - SHELF_DEPTH / 2 - 0.03  # the shelf's front edge less 3 cm, as the rule was first written
 
@@ -31,15 +33,6 @@ def tiny_env():
     yield make
     for env in envs:
         env.close()
-
-
-@pytest.mark.parametrize("task", TASKS)
-def test_demonstrator_completes_its_task(tiny_env, task):
-    env = tiny_env(task)
-    results = [run_episode(env, seed) for seed in range(3)]
-    assert any(r.success for r in results), f"{task}: no success in 3 seeds"
-    for result in results:
-        assert result.actions.shape == (result.length_steps, 19) and np.isfinite(result.actions).all()
 
 
 def _rule_before_evaluate(env) -> bool:
@@ -67,8 +60,24 @@ class _Steps(gym.Wrapper):
         return *rest, info
 
 
+def _successes(env, seeds, enough: int, played=()) -> int:
+    """How many of `seeds` the demonstrator completes, played in order until `enough` have (episodes are
+    deterministic: the seeds left unplayed cannot change the verdict `>= enough`); each played episode's actions are
+    checked. `played`: results of seeds already played, counted first."""
+    results = list(played)
+    for seed in seeds:
+        if sum(r.success for r in results) >= enough:
+            break
+        results.append(run_episode(env, seed))
+    for result in results:
+        assert result.actions.shape == (result.length_steps, 19) and np.isfinite(result.actions).all()
+    return sum(r.success for r in results)
+
+
 @pytest.mark.parametrize("task", TASKS)
-def test_evaluate_decides_as_before_over_a_demonstration_and_the_log_keeps_its_conditions(tiny_env, task, tmp_path):
+def test_demonstrator_completes_its_task_and_evaluate_decides_as_before(tiny_env, task, tmp_path):
+    """Seed 0 played with the episode log and the success rule as it was before `Task.evaluate` beside every step;
+    seeds 1 and 2 only while none has succeeded."""
     log = tmp_path / "episodes.jsonl"
     env = _Steps(EpisodeLogger(tiny_env(task, cameras=()), log, "suite", 0))
     result = run_episode(env, seed=0)
@@ -87,6 +96,8 @@ def test_evaluate_decides_as_before_over_a_demonstration_and_the_log_keeps_its_c
         assert 0.0 <= reach[-1]["first_grasp_xy_m"] <= 0.02, reach[-1]  # pads centred on the object
         across_jaws = reach[-1]["first_grasp_in_hand_m"][1]  # the object's centre between the pads
         assert abs(across_jaws) <= 0.012 and np.linalg.norm(reach[-1]["first_grasp_in_hand_m"]) <= REACHED_M, reach[-1]
+    completed = _successes(tiny_env(task, cameras=()), (1, 2), enough=1, played=[result])
+    assert completed >= 1, f"{task}: no success in 3 seeds"
 
 
 @pytest.mark.parametrize("task", ["conditional_pick", "clutter_pick_lift"])
@@ -102,8 +113,7 @@ def test_reachy2_succeeds_where_its_arm_used_to_get_stuck(tiny_env, task, seeds)
     """id seeds that Reachy2's demonstrator failed in every one of its 3 attempts before its IK kept the elbow bent
     and weighed hand tilt less (top-shelf objects held but left in the shelf), and before it peeked into the box
     from reachable poses (the arm jammed on the box, the object never grasped)."""
-    env = tiny_env(task, robot="reachy2", cameras=())
-    assert sum(run_episode(env, seed).success for seed in seeds) >= 2
+    assert _successes(tiny_env(task, robot="reachy2", cameras=()), seeds, enough=2) >= 2
 
 
 def test_peek_falls_back_to_a_reachable_wrist_pose(tiny_env):

@@ -1,8 +1,11 @@
 import numpy as np
+import pytest
 
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, VISUAL_FACTORS
 from lerobot_tavis.gallery import (OOD_VISUAL_VIEWS, SHEET_VIEWS, GalleryConfig, Stills, capture_stills,
                                    ood_visual_sheet, overview_figure, write_gallery)
+
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
 
 def test_task_sheet_shows_the_first_observation_and_the_grasp(tmp_path):

@@ -5,16 +5,13 @@ import numpy as np
 
 from lerobot_tavis import canonical
 from lerobot_tavis.dataset_tools.raw import Manifest, load_episode
-from lerobot_tavis.dataset_tools.record import RecordConfig, record
 from lerobot_tavis.envs.transforms import axis_angle_quat, quat_multiply
 
 
-def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(benchmark_script, tmp_path):
+def test_the_grasping_arm_is_found_and_a_hand_sent_far_below_the_grasp_fails(benchmark_script, conditional_pick_raw):
     probe = benchmark_script("grasp_tolerance")
-    record(RecordConfig(out_dir=tmp_path / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
-           progress=False)
-    entry = next(e for e in Manifest.load(tmp_path / "raw").episodes if e.file)
-    path = str(tmp_path / "raw" / entry.file)
+    entry = next(e for e in Manifest.load(conditional_pick_raw).episodes if e.file)
+    path = str(conditional_pick_raw / entry.file)
     actions = load_episode(path).actions
     arm = probe.grasping_arm(actions)
     idle = next(a for a in canonical.ARMS if a is not arm)

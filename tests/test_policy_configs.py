@@ -14,8 +14,9 @@ import pytest
 from lerobot_tavis import canonical
 from lerobot_tavis.cli import main
 from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
-from lerobot_tavis.dataset_tools.record import RecordConfig, record
 from lerobot_tavis.policy_configs import build_preset, preset_names, preset_path, presets
+
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
 TINY = (48, 64)
 # Small enough for a CPU: the preset's network shrunk, 1-second episodes, two denoising steps.
@@ -25,12 +26,10 @@ SMALL_RUN = ["--env.task=conditional_pick", f"--env.image_size=[{TINY[0]},{TINY[
 
 
 @pytest.fixture(scope="module")
-def dataset_root(tmp_path_factory):
+def dataset_root(conditional_pick_demonstration, tmp_path_factory):
     """One conditional_pick demonstration converted with all four cameras at 48x64."""
-    scratch = tmp_path_factory.mktemp("presets")
-    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",),
-                        episodes_per_task=1), progress=False)
-    return convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=TINY), progress=False)
+    return convert(ConvertConfig(conditional_pick_demonstration, "local/tiny",
+                                 tmp_path_factory.mktemp("presets") / "dataset", image_size=TINY), progress=False)
 
 
 def _parse(name, *overrides):
@@ -115,12 +114,11 @@ def test_compact_presets_anneal_the_learning_rate_to_zero_at_the_last_step(name)
     assert (optimizer.defaults["weight_decay"], cfg.optimizer.grad_clip_norm) == (1e-4, 10.0)
 
 
-def test_zero_neck_conversion_for_the_fixed_camera_presets(dataset_root, tmp_path):
+def test_zero_neck_conversion_for_the_fixed_camera_presets(conditional_pick_demonstration, tmp_path):
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    raw = dataset_root.parent / "raw"
-    root = convert(ConvertConfig(raw, "local/zero", tmp_path / "zero", image_size=TINY, cameras=("fixed",),
-                                 zero_neck=True), progress=False)
+    root = convert(ConvertConfig(conditional_pick_demonstration, "local/zero", tmp_path / "zero", image_size=TINY,
+                                 cameras=("fixed",), zero_neck=True), progress=False)
     table = LeRobotDataset("local/zero", root=root, video_backend="pyav").hf_dataset
     state, action = (np.stack(table[key]) for key in ("observation.state", "action"))
     assert np.all(state[:, canonical.HEAD] == 0) and np.all(action[:, canonical.HEAD] == 0)

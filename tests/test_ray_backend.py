@@ -14,6 +14,8 @@ from lerobot_tavis.dataset_tools.raw import Manifest
 from lerobot_tavis.dataset_tools.record import RecordConfig, record
 from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 RAY = str(Path(sys.executable).with_name("ray"))
 
 

@@ -14,6 +14,8 @@ import pytest
 
 from lerobot_tavis.viewer import NoDisplayError, ViewConfig, view
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 PLAY = """
 import json, time
 from lerobot_tavis.viewer import ViewConfig, view
@@ -75,17 +77,14 @@ def test_the_window_follows_a_camera_and_queues_key_presses(virtual_display):
 
 
 @pytest.fixture(scope="module")
-def act_checkpoint(tmp_path_factory):
+def act_checkpoint(conditional_pick_demonstration, tmp_path_factory):
     """An ACT checkpoint of the compact head + wrists preset after one training step on one demonstration."""
     from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
-    from lerobot_tavis.dataset_tools.record import RecordConfig, record
     from lerobot_tavis.policy_configs import preset_path
 
     scratch = tmp_path_factory.mktemp("view_policy")
-    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",),
-                        episodes_per_task=1), progress=False)
-    root = convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=(120, 160),
-                                 cameras=("head", "left_wrist", "right_wrist")), progress=False)
+    root = convert(ConvertConfig(conditional_pick_demonstration, "local/tiny", scratch / "dataset",
+                                 image_size=(120, 160), cameras=("head", "left_wrist", "right_wrist")), progress=False)
     train = [sys.executable, "-m", "lerobot.scripts.lerobot_train",
              f"--config_path={preset_path('act_head_wrist_compact')}", "--dataset.repo_id=local/tiny",
              f"--dataset.root={root}", "--env.task=conditional_pick", "--policy.device=cpu", "--steps=1",

@@ -15,8 +15,9 @@ import torch
 from lerobot_tavis.cli import main
 from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
 from lerobot_tavis.dataset_tools.frame_cache import FrameCache, StaleFrameCacheError, cache_dir
-from lerobot_tavis.dataset_tools.record import RecordConfig, record
 from lerobot_tavis.policy_configs import preset_path
+
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
 TINY = (48, 64)
 CAMERAS = ("head", "left_wrist", "right_wrist")
@@ -28,13 +29,11 @@ DELTA_TIMESTAMPS = {**{key: [-2 / FPS, -1 / FPS, 0.0] for key in [*CAMERA_KEYS, 
 
 
 @pytest.fixture(scope="module")
-def dataset_root(tmp_path_factory):
-    """Two conditional_pick demonstrations at 48x64 with the head and wrist cameras (AV1), and their frame cache."""
-    scratch = tmp_path_factory.mktemp("frame_cache")
-    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=2),
-           progress=False)
-    root = convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=TINY, cameras=CAMERAS),
-                   progress=False)
+def dataset_root(conditional_pick_raw, tmp_path_factory):
+    """The run's two conditional_pick demonstrations at 48x64 with the head and wrist cameras (AV1), and their frame
+    cache."""
+    root = convert(ConvertConfig(conditional_pick_raw, "local/tiny", tmp_path_factory.mktemp("frame_cache") / "dataset",
+                                 image_size=TINY, cameras=CAMERAS), progress=False)
     main(["cache-frames", str(root)])
     return root
 

@@ -1,4 +1,5 @@
-"""`tavis verify-dataset`: a converted dataset replays as recorded; actions misaligned by one frame do not."""
+"""`tavis verify-dataset`: a converted dataset (the run's two conditional_pick demonstrations, tests/conftest.py)
+replays as recorded; actions misaligned by one frame do not."""
 
 import json
 import shutil
@@ -6,35 +7,24 @@ import shutil
 import pytest
 
 from lerobot_tavis.cli import main
-from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG, ConvertConfig, convert
-from lerobot_tavis.dataset_tools.record import RecordConfig, record
+from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG
 from lerobot_tavis.dataset_tools.verify import TOLERANCE_M, verify_dataset
 
 
-@pytest.fixture(scope="module")
-def dataset_root(tmp_path_factory):
-    """Two conditional_pick demonstrations (GR1T2) at 20 Hz, head camera only, 48x64."""
-    scratch = tmp_path_factory.mktemp("verify")
-    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",),
-                        episodes_per_task=2), progress=False)
-    return convert(ConvertConfig(scratch / "raw", "local/verify", scratch / "dataset", image_size=(48, 64),
-                                 cameras=("head",)), progress=False)
-
-
-def test_a_converted_dataset_replays_as_recorded(dataset_root, capsys):
-    main(["verify-dataset", str(dataset_root)])
+def test_a_converted_dataset_replays_as_recorded(conditional_pick_dataset, capsys):
+    main(["verify-dataset", str(conditional_pick_dataset)])
     out = capsys.readouterr().out
     assert "2 episodes replay as recorded" in out and out.count(": ok") == 2
 
 
 @pytest.mark.parametrize("shift", [1, -1])
-def test_actions_one_frame_off_are_caught(dataset_root, shift):
-    checks = verify_dataset(dataset_root, action_shift=shift)
+def test_actions_one_frame_off_are_caught(conditional_pick_dataset, shift):
+    checks = verify_dataset(conditional_pick_dataset, action_shift=shift)
     assert all(check.max_hand_error_m > 1.5 * TOLERANCE_M and not check.passed for check in checks)
 
 
-def test_a_failing_dataset_exits_with_the_episodes_named(dataset_root, tmp_path, capsys):
-    broken = shutil.copytree(dataset_root, tmp_path / "broken")
+def test_a_failing_dataset_exits_with_the_episodes_named(conditional_pick_dataset, tmp_path, capsys):
+    broken = shutil.copytree(conditional_pick_dataset, tmp_path / "broken")
     log_path = broken / CONVERSION_LOG
     log = json.loads(log_path.read_text())
     log["episodes"][1]["seed"] += 1  # episode 1 now claims another scene
@@ -44,10 +34,10 @@ def test_a_failing_dataset_exits_with_the_episodes_named(dataset_root, tmp_path,
     assert "episode    0" in capsys.readouterr().out
 
 
-def test_bad_input_is_a_clear_error(dataset_root, tmp_path):
+def test_bad_input_is_a_clear_error(conditional_pick_dataset, tmp_path):
     with pytest.raises(SystemExit, match="no episodes \\[5\\]; it holds 0..1"):
-        main(["verify-dataset", str(dataset_root), "--episodes", "5"])
-    plain = shutil.copytree(dataset_root, tmp_path / "plain")
+        main(["verify-dataset", str(conditional_pick_dataset), "--episodes", "5"])
+    plain = shutil.copytree(conditional_pick_dataset, tmp_path / "plain")
     (plain / CONVERSION_LOG).unlink()
     with pytest.raises(SystemExit, match="only datasets written by `tavis convert` can be replayed"):
         main(["verify-dataset", str(plain)])

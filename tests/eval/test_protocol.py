@@ -18,19 +18,24 @@ from lerobot_tavis.eval.protocol import Cell, ProtocolConfig, run_protocol
 from lerobot_tavis.eval.report import write_report
 from lerobot_tavis.eval.run_identity import run_identity
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
-def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
-    cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",),
-                         n_episodes=2, workers=1)
+
+def test_expert_protocol_writes_cells_and_report_resumes_and_ignores_workers_and_chunking(tmp_path, capsys):
+    """A cell and its report, kept by a second run; then the cell played again over 2 workers in chunks of one seed
+    (finishing in any order) is the cell one process wrote."""
+    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2)
+    one = tmp_path / "one"
+    cfg = ProtocolConfig(out_dir=one, workers=1, **common)
     written = {p.name for p in run_protocol(cfg)}
     assert {"results.md", "results.json", "success_rates.png"} <= written
-    cell = tmp_path / "tavis_hands__id"
+    cell = one / "tavis_hands__id"
     info = json.loads((cell / "eval_info.json").read_text())
     assert [t["task_id"] for t in info["per_task"]] == [0, 1, 2]
     records = [json.loads(line) for line in (cell / "episodes.jsonl").read_text().splitlines()]
     assert sorted((r["task"], r["seed"]) for r in records) == sorted(
         (task, seed) for task in suite_tasks("tavis_hands") for seed in (1000, 1001))
-    results = json.loads((tmp_path / "results.json").read_text())
+    results = json.loads((one / "results.json").read_text())
     assert sum(c["n"] for c in results["cells"]) == 6
     before = (cell / "eval_info.json").stat().st_mtime_ns
     run_protocol(cfg)
@@ -38,7 +43,10 @@ def test_expert_protocol_writes_cells_and_report_and_resumes(tmp_path, capsys):
     assert "tavis_hands__id: done already, skipped" in out
     assert re.search(r"episodes played in \d+\.\d s, report written in \d+\.\d s", out)
     assert (cell / "eval_info.json").stat().st_mtime_ns == before
-    assert not list(tmp_path.glob(".*partial*"))
+    assert not list(one.glob(".*partial*"))
+    run_protocol(ProtocolConfig(out_dir=tmp_path / "two", workers=2, chunk_episodes=1, **common))
+    assert _cell_files(one) == _cell_files(tmp_path / "two")
+    assert not list((tmp_path / "two").glob(".*"))  # the chunks are gone once the cell is written
 
 
 def test_tasks_play_only_those_tasks_and_a_cell_of_other_tasks_is_not_reused(tmp_path):
@@ -64,15 +72,6 @@ def test_a_task_outside_the_suites_is_refused(tmp_path):
 
 def _cell_files(root, cell="tavis_hands__id"):
     return ((root / cell / "episodes.jsonl").read_text(), json.loads((root / cell / "eval_info.json").read_text()))
-
-
-def test_expert_results_do_not_depend_on_workers_or_chunking(tmp_path):
-    """Chunks of one seed finish in any order over 2 workers; the cell is the same as one process playing all."""
-    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2)
-    run_protocol(ProtocolConfig(out_dir=tmp_path / "one", workers=1, **common))
-    run_protocol(ProtocolConfig(out_dir=tmp_path / "two", workers=2, chunk_episodes=1, **common))
-    assert _cell_files(tmp_path / "one") == _cell_files(tmp_path / "two")
-    assert not list((tmp_path / "two").glob(".*"))  # the chunks are gone once the cell is written
 
 
 def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):

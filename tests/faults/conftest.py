@@ -1,38 +1,23 @@
-"""Shared material of the fault-injection suite: a small real recording, its dataset and an evaluation to damage."""
+"""Shared material of the fault-injection suite: copies of the run's small recording and its dataset, and an
+evaluation, to damage."""
 
 import shutil
 
 import pytest
 
 from lerobot_tavis.cli import main
-from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
-from lerobot_tavis.dataset_tools.record import RecordConfig, record
-
-
-@pytest.fixture(scope="session")
-def raw_dir(tmp_path_factory):
-    """Two conditional_pick demonstrations (GR1T2), recorded once; tests damage copies of it."""
-    out = tmp_path_factory.mktemp("faults") / "raw"
-    record(RecordConfig(out_dir=out, robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=2), progress=False)
-    return out
 
 
 @pytest.fixture
-def raw_copy(raw_dir, tmp_path):
-    return shutil.copytree(raw_dir, tmp_path / "raw")
-
-
-@pytest.fixture(scope="session")
-def dataset_dir(raw_dir, tmp_path_factory):
-    """The recording converted once: 20 Hz, the head camera only, 48x64 AV1 video."""
-    root = tmp_path_factory.mktemp("faults_dataset") / "dataset"
-    return convert(ConvertConfig(raw_dir, "local/faults", root, image_size=(48, 64), cameras=("head",)),
-                   progress=False)
+def raw_copy(conditional_pick_raw, tmp_path):
+    """A copy of the run's two conditional_pick demonstrations (tests/conftest.py) to damage."""
+    return shutil.copytree(conditional_pick_raw, tmp_path / "raw")
 
 
 @pytest.fixture
-def dataset_copy(dataset_dir, tmp_path):
-    return shutil.copytree(dataset_dir, tmp_path / "dataset")
+def dataset_copy(conditional_pick_dataset, tmp_path):
+    """A copy of their dataset (20 Hz, the head camera only, 48x64 AV1 video) to damage."""
+    return shutil.copytree(conditional_pick_dataset, tmp_path / "dataset")
 
 
 @pytest.fixture(scope="session")

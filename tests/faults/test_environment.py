@@ -23,6 +23,8 @@ from lerobot_tavis.eval.report import build_report
 from lerobot_tavis.staging import staged_directory
 from tests.eval.test_report import _eval_dir
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 EXPERT_EVAL = ["eval", "--expert", "--tasks", "conditional_pick", "--splits", "id", "--episode-length-s", "0.5"]
 _PR_CAPBSET_DROP = 24  # from <linux/prctl.h>
 _ROOT_OVERRIDES = (1, 2, 3)  # CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH, CAP_FOWNER

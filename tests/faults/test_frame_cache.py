@@ -2,6 +2,7 @@
 with one line naming the problem, before any training; a misspelt switch stops the process in one line too."""
 
 import os
+import shutil
 import subprocess
 import sys
 
@@ -12,12 +13,13 @@ from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
 from lerobot_tavis.dataset_tools.frame_cache import cache_dir
 from lerobot_tavis.policy_configs import preset_path
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 
 @pytest.fixture(scope="module")
-def dataset_root(raw_dir, tmp_path_factory):
-    """The fault suite's recording converted with the head camera at 48x64, with its frame cache."""
-    root = convert(ConvertConfig(raw_dir, "local/tiny", tmp_path_factory.mktemp("frame_cache") / "dataset",
-                                 image_size=(48, 64), cameras=("head",)), progress=False)
+def dataset_root(conditional_pick_dataset, tmp_path_factory):
+    """A copy of the run's conditional_pick dataset (the head camera at 48x64), with its frame cache."""
+    root = shutil.copytree(conditional_pick_dataset, tmp_path_factory.mktemp("frame_cache") / "dataset")
     main(["cache-frames", str(root)])
     return root
 
@@ -83,9 +85,9 @@ def test_cache_frames_refuses_what_it_cannot_cache_in_one_line_and_writes_nothin
     assert not cache_dir(missing).exists()
 
 
-def test_cache_frames_refuses_a_dataset_without_videos(raw_dir, tmp_path):
-    root = convert(ConvertConfig(raw_dir, "local/png", tmp_path / "dataset", image_size=(48, 64), cameras=("head",),
-                                 storage="png", task="conditional_pick"), progress=False)
+def test_cache_frames_refuses_a_dataset_without_videos(conditional_pick_raw, tmp_path):
+    root = convert(ConvertConfig(conditional_pick_raw, "local/png", tmp_path / "dataset", image_size=(48, 64),
+                                 cameras=("head",), storage="png", task="conditional_pick"), progress=False)
     with pytest.raises(SystemExit) as refusal:
         main(["cache-frames", str(root)])
     assert refusal.value.code == (f"tavis cache-frames: error: {root.absolute()}: the dataset stores no video "

@@ -19,6 +19,8 @@ from lerobot_tavis.errors import InputError
 from lerobot_tavis.eval.report import build_report
 from lerobot_tavis.locking import exclusive_output, lock_path
 
+pytestmark = pytest.mark.slow  # conftest.py: its file starts first
+
 EVAL = ["eval", "--tasks", "peeking_box", "--splits", "id", "--episode-length-s", "1",
         "--film-episodes", "0"]
 CELL = "tavis_hands__id"

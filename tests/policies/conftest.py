@@ -12,6 +12,7 @@ import torch
 from lerobot.utils.constants import ACTION, OBS_STATE
 
 from lerobot_tavis import canonical
+from tests.conftest import built_once_per_run
 
 
 def made_up_episode(rng, length: int) -> tuple[np.ndarray, np.ndarray]:
@@ -43,19 +44,18 @@ def dataset_root(tmp_path):
 
 
 @pytest.fixture(scope="session")
-def demonstration(tmp_path_factory):
-    """One conditional_pick demonstration (GR1T2) converted with the head camera at 32x32: the dataset's `root`, the
-    episode's `seed`, its `actions` and `states` (T, 19, float32 tensors) in frame order."""
+def demonstration(conditional_pick_demonstration, tmp_path_factory):
+    """The run's one recorded conditional_pick demonstration (GR1T2) converted once per run with the head camera at
+    32x32: the dataset's `root`, the episode's `seed`, its `actions` and `states` (T, 19, float32 tensors) in frame
+    order."""
     import pandas as pd
 
     from lerobot_tavis.dataset_tools.convert import CONVERSION_LOG, ConvertConfig, convert
-    from lerobot_tavis.dataset_tools.record import RecordConfig, record
+    def build(path):
+        convert(ConvertConfig(conditional_pick_demonstration, "local/tiny", path, image_size=(32, 32),
+                              cameras=("head",)), progress=False)
 
-    scratch = tmp_path_factory.mktemp("demonstration")
-    record(RecordConfig(out_dir=scratch / "raw", robot="gr1t2", tasks=("conditional_pick",), episodes_per_task=1),
-           progress=False)
-    root = convert(ConvertConfig(scratch / "raw", "local/tiny", scratch / "dataset", image_size=(32, 32),
-                                 cameras=("head",)), progress=False)
+    root = built_once_per_run(tmp_path_factory, "hand_frame_demonstration", build)
     (entry,) = json.loads((root / CONVERSION_LOG).read_text())["episodes"]
     frames = pd.read_parquet(next((root / "data").rglob("*.parquet"))).sort_values("frame_index")
     actions, states = (torch.tensor(np.stack(frames[key].to_numpy()), dtype=torch.float32)
