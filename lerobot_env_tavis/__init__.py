@@ -6,8 +6,7 @@ one line instead of a traceback, and so is LeRobot's warning that torchcodec can
 lerobot-train, a TAVIS config (`--config_path=<preset>`) whose dataset lacks the policy's cameras, or holds them at
 another size than an ACT policy's, ends the run in one line (`policy_configs.refuse_unfit_training_dataset`); with
 `TAVIS_FRAME_CACHE=1` (or `float32`), lerobot-train (which has loaded LeRobot's dataset factory by then) reads video
-frames from the
-frame cache (`lerobot_tavis.dataset_tools.cached_dataset`)."""
+frames from the frame cache (`lerobot_tavis.dataset_tools.cached_dataset`)."""
 
 import sys
 
