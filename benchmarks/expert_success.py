@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import multiprocessing
 import os
 import time
+from concurrent.futures import as_completed
 from pathlib import Path
 
 
@@ -55,6 +55,7 @@ def main() -> None:
     from lerobot_tavis.envs.robots import BUILTIN_ROBOTS
     from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS
     from lerobot_tavis.metrics.stats import wilson_interval
+    from lerobot_tavis.workers import executor
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--episodes", type=int, default=96)
@@ -81,8 +82,9 @@ def main() -> None:
             successes, leads = json.loads(_chunk_file(args.results, *job).read_text())
             add(*job, successes, leads)
             jobs.remove(job)
-    with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
-        for task, robot, split, seeds, successes, leads in pool.imap_unordered(run_chunk, jobs):
+    with executor(args.workers) as pool:  # each worker on its own share of the CPUs
+        for done in as_completed([pool.submit(run_chunk, job) for job in jobs]):
+            task, robot, split, seeds, successes, leads = done.result()
             add(task, robot, split, seeds, successes, leads)
             if args.results is not None:
                 atomic.write_text(_chunk_file(args.results, task, robot, split, seeds), json.dumps([successes, leads]))

@@ -5,7 +5,10 @@ process, which alone writes files. So the backend, the number of workers and the
 change what is written, and a Ray cluster needs no filesystem shared with the caller.
 
 - `local`: `workers` spawned processes, or the calling process when workers == 1. A worker never outlives the
-  process that started it (`lerobot_tavis.process`), so no orphan keeps recording or holds staging files.
+  process that started it (`lerobot_tavis.process`), so no orphan keeps recording or holds staging files. Each
+  worker runs on its own share of the caller's CPUs (`cpu_share`): libraries that start one thread per CPU they
+  may use (FFmpeg's AV1 decoder starts about 1.5 per CPU for every video it opens) then start a few, not one per
+  core of the machine in every worker (on 64 cores, thousands of threads fighting over them).
 - `ray`: Ray tasks, on the cluster named by `RAY_ADDRESS` (`ray start --head` on one node, `ray start
   --address=...` on the others), else on a Ray instance started on this machine for the run. Install with
   `pip install 'lerobot_env_tavis[ray]'`; docs/scaling.md.
@@ -103,8 +106,17 @@ def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0, ni
         return RayExecutor(gpus=gpus_per_job)
     if workers == 1:
         return InlineExecutor()
-    return ProcessPoolExecutor(workers, mp_context=_SpawnContext(), initializer=_start_local_worker,
-                               initargs=(os.getpid(), niceness))
+    context = _SpawnContext()
+    started = context.Value("i", 0)  # workers started so far: each takes the next share of the CPUs
+    return ProcessPoolExecutor(workers, mp_context=context, initializer=_start_local_worker,
+                               initargs=(os.getpid(), niceness, started, workers, sorted(os.sched_getaffinity(0))))
+
+
+def cpu_share(index: int, workers: int, cpus: list[int]) -> set[int]:
+    """The CPUs worker `index` (0-based) of `workers` runs on: every `workers`-th of `cpus` from its index on, so
+    the shares cover `cpus` and differ; with more workers than CPUs, one CPU (`index` modulo their number)."""
+    share = cpus[index % workers::workers] if workers <= len(cpus) else []
+    return set(share or [cpus[index % len(cpus)]])
 
 
 class _SpawnedWorker(multiprocessing.context.SpawnProcess):
@@ -120,8 +132,12 @@ class _SpawnContext(multiprocessing.context.SpawnContext):
     Process = _SpawnedWorker
 
 
-def _start_local_worker(parent_pid: int, niceness: int) -> None:
+def _start_local_worker(parent_pid: int, niceness: int, started, workers: int, cpus: list[int]) -> None:
     die_with_parent(parent_pid)
     leave_interrupt_to_parent()
     if niceness:
         os.nice(niceness)
+    with started.get_lock():
+        index = started.value
+        started.value += 1
+    os.sched_setaffinity(0, cpu_share(index, workers, cpus))
