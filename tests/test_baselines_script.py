@@ -18,7 +18,7 @@ TAVIS = LOG_CALL + """value() {  # the argument after $FLAG
   local previous; for arg in "$@"; do [ "${previous:-}" = "$FLAG" ] && echo "$arg"; previous=$arg; done; }
 case $1 in
   record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
-  presets) echo /dev/null ;;
+  presets) python3 -m lerobot_tavis.cli presets "$2" ;;  # the real file: train_baseline reads its budget
   convert|curve) ;;
   eval) out=${@: -1}; mkdir -p "$out/tavis_head__id/videos" "$out/.tavis_head__id.chunks"
     format='{"cells": [{"task": "%s", "split": "id", "successes": 1, "n": 2}], '
