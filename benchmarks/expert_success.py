@@ -82,7 +82,7 @@ def main() -> None:
             successes, leads = json.loads(_chunk_file(args.results, *job).read_text())
             add(*job, successes, leads)
             jobs.remove(job)
-    with executor(args.workers) as pool:  # each worker on its own share of the CPUs
+    with executor(args.workers, share_cpus=True) as pool:  # each worker on its own share of the CPUs
         for done in as_completed([pool.submit(run_chunk, job) for job in jobs]):
             task, robot, split, seeds, successes, leads = done.result()
             add(task, robot, split, seeds, successes, leads)

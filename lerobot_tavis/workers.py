@@ -5,10 +5,11 @@ process, which alone writes files. So the backend, the number of workers and the
 change what is written, and a Ray cluster needs no filesystem shared with the caller.
 
 - `local`: `workers` spawned processes, or the calling process when workers == 1. A worker never outlives the
-  process that started it (`lerobot_tavis.process`), so no orphan keeps recording or holds staging files. Each
-  worker runs on its own share of the caller's CPUs (`cpu_share`): libraries that start one thread per CPU they
-  may use (FFmpeg's AV1 decoder starts about 1.5 per CPU for every video it opens) then start a few, not one per
-  core of the machine in every worker (on 64 cores, thousands of threads fighting over them).
+  process that started it (`lerobot_tavis.process`), so no orphan keeps recording or holds staging files. With
+  `share_cpus`, each worker runs on its own share of the caller's CPUs (`cpu_share`): libraries that start one
+  thread per CPU they may use (FFmpeg's AV1 decoder starts about 1.5 per CPU for every video it opens) then start
+  a few, not one per core of the machine in every worker (on 64 cores, thousands of threads fighting over them).
+  Only for jobs whose results do not depend on a thread count: a video encoder's output does.
 - `ray`: Ray tasks, on the cluster named by `RAY_ADDRESS` (`ray start --head` on one node, `ray start
   --address=...` on the others), else on a Ray instance started on this machine for the run. Install with
   `pip install 'lerobot_env_tavis[ray]'`; docs/scaling.md.
@@ -95,11 +96,12 @@ def usable_cores() -> int:
     return len(os.sched_getaffinity(0))
 
 
-def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0, niceness: int = 0):
+def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0, niceness: int = 0,
+             share_cpus: bool = False):
     """The pool for `backend`: local spawned processes (MuJoCo's EGL contexts and torch do not survive a fork), or
     inline for one worker; Ray ignores `workers` and runs what the cluster's resources allow. Local worker
     processes add `niceness` to their niceness (as `nice`: 19 runs them only on cores nothing else wants); the
-    calling process and Ray's workers keep theirs."""
+    calling process and Ray's workers keep theirs. `share_cpus`: each local worker on its own share of the CPUs."""
     checks.integer("workers", workers, 1)
     checks.integer("niceness", niceness, 0, MAX_NICENESS)
     if checks.choice("backend", backend, BACKENDS) == "ray":
@@ -108,8 +110,9 @@ def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0, ni
         return InlineExecutor()
     context = _SpawnContext()
     started = context.Value("i", 0)  # workers started so far: each takes the next share of the CPUs
+    cpus = sorted(os.sched_getaffinity(0)) if share_cpus else None
     return ProcessPoolExecutor(workers, mp_context=context, initializer=_start_local_worker,
-                               initargs=(os.getpid(), niceness, started, workers, sorted(os.sched_getaffinity(0))))
+                               initargs=(os.getpid(), niceness, started, workers, cpus))
 
 
 def cpu_share(index: int, workers: int, cpus: list[int]) -> set[int]:
@@ -132,11 +135,13 @@ class _SpawnContext(multiprocessing.context.SpawnContext):
     Process = _SpawnedWorker
 
 
-def _start_local_worker(parent_pid: int, niceness: int, started, workers: int, cpus: list[int]) -> None:
+def _start_local_worker(parent_pid: int, niceness: int, started, workers: int, cpus: list[int] | None) -> None:
     die_with_parent(parent_pid)
     leave_interrupt_to_parent()
     if niceness:
         os.nice(niceness)
+    if cpus is None:
+        return
     with started.get_lock():
         index = started.value
         started.value += 1

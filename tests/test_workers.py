@@ -47,9 +47,16 @@ def _pid_and_cpus(_) -> tuple[int, frozenset[int]]:
 
 @pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="needs two CPUs to share")
 def test_each_local_worker_runs_on_its_own_share_of_the_cpus():
-    with executor(2) as pool:
+    with executor(2, share_cpus=True) as pool:
         jobs = [pool.submit(_pid_and_cpus, job) for job in range(6)]
         seen = dict(job.result() for job in jobs)
     shares = list(seen.values())
     assert len(shares) == 2 and not shares[0] & shares[1]
     assert shares[0] | shares[1] == os.sched_getaffinity(0)
+
+
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="needs two CPUs to share")
+def test_without_share_cpus_local_workers_see_every_cpu():
+    with executor(2) as pool:
+        jobs = [pool.submit(_pid_and_cpus, job) for job in range(4)]
+        assert {job.result()[1] for job in jobs} == {frozenset(os.sched_getaffinity(0))}

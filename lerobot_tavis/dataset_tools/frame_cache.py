@@ -106,7 +106,7 @@ def write_frame_cache(cfg: CacheFramesConfig) -> list[str]:
                   for key in meta.video_keys}
         np.save(staging / TIMESTAMPS_FILE, rows["timestamp"].to_numpy(np.float64))
         jobs = [(episode, key) for episode in range(meta.total_episodes) for key in meta.video_keys]
-        with executor(min(cfg.workers, len(jobs))) as pool:
+        with executor(min(cfg.workers, len(jobs)), share_cpus=True) as pool:  # decoders: a few threads each
             futures = {pool.submit(decode_episode, *_decode_arguments(meta, rows, episode, key),
                                    cfg.video_backend): (episode, key) for episode, key in jobs}
             for future in tqdm(as_completed(futures), total=len(jobs), desc=f"cache-frames {root.name}",
