@@ -13,21 +13,7 @@ def test_a_rerun_plays_only_the_missing_chunk_and_writes_the_table(benchmark_scr
         task, robot, split, seeds = job
         return task, robot, split, seeds, 1, [1.0]
 
-    class InlinePool:  # the jobs run in this process, so the stand-in is what runs
-        def __init__(self, workers):
-            pass
-
-        def __enter__(self):
-            return self
-
-        def __exit__(self, *exc):
-            return False
-
-        def imap_unordered(self, function, jobs):
-            return map(function, jobs)
-
     monkeypatch.setattr(script, "run_chunk", run_chunk)
-    monkeypatch.setattr(script.multiprocessing, "get_context", lambda method: type("Ctx", (), {"Pool": InlinePool}))
     results, table = tmp_path / "chunks", tmp_path / "table.md"
     results.mkdir()
     (results / "conditional_pick-gr1t2-id-0-2.json").write_text(json.dumps([2, [0.5, None]]))  # kept from before

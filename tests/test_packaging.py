@@ -2,7 +2,10 @@ import re
 import shutil
 import subprocess
 import sys
+import threading
 import zipfile
+from functools import partial
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -44,9 +47,16 @@ def test_setup_with_cpu_installs_torch_from_the_cpu_index_before_the_package(tmp
     result, calls = _make_setup(tmp_path)
     assert result.returncode == 0 and not [call for call in calls if "--index-url" in call]
     assert calls[-1] == "-m pip install -e .[dev]"
-    result, calls = _make_setup(tmp_path / "cpu", "CPU=1")
+    (tmp_path / "index" / "whl" / "cpu" / "torch").mkdir(parents=True)
+    (tmp_path / "index" / "whl" / "cpu" / "torch" / "index.html").write_text("<html></html>")
+    serve = partial(SimpleHTTPRequestHandler, directory=str(tmp_path / "index"))
+    with ThreadingHTTPServer(("127.0.0.1", 0), serve) as server:  # a reachable stand-in for PyTorch's index
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        index = f"http://127.0.0.1:{server.server_address[1]}/whl/cpu"
+        result, calls = _make_setup(tmp_path / "cpu", "CPU=1", f"TORCH_CPU_INDEX={index}")
+        server.shutdown()
     assert result.returncode != 0
-    assert calls[-1].startswith("-m pip install --index-url https://download.pytorch.org/whl/cpu torch>=2.7,<2.12 ")
+    assert calls[-1].startswith(f"-m pip install --index-url {index} torch>=2.7,<2.12 ")
     assert "CPU=1: PyTorch's CPU wheels could not be installed" in result.stdout + result.stderr
     assert not (tmp_path / "cpu" / "venv" / ".installed").exists()
 
