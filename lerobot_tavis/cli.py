@@ -10,13 +10,17 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterable
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 
 from lerobot_tavis.cli_options import CommandParser, from_args, option, spelling
 from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError, surroundings_message
 from lerobot_tavis.tempdir import use_private_tempdir
+
+INTERRUPT_GRACE_S = 1.0  # how long a broken worker pool waits for the Ctrl-C that may have broken it
 
 
 @dataclass(frozen=True)
@@ -384,8 +388,20 @@ def main(argv: list[str] | None = None) -> None:
             raise
         sys.exit(f"{command}: error: {line}")
     except KeyboardInterrupt:  # Ctrl-C; the unwinding has removed the staging copies and stopped the workers
-        print(f"{command}: interrupted", file=sys.stderr)
-        sys.exit(128 + signal.SIGINT)
+        _interrupted(command)
+    except BrokenProcessPool:
+        # Ctrl-C reaches the workers too, which end at once: the pool may report them gone before this process's
+        # own KeyboardInterrupt arrives. Wait for it; a pool broken otherwise is a bug, with its traceback.
+        try:
+            time.sleep(INTERRUPT_GRACE_S)
+        except KeyboardInterrupt:
+            _interrupted(command)
+        raise
+
+
+def _interrupted(command: str) -> None:
+    print(f"{command}: interrupted", file=sys.stderr)
+    sys.exit(128 + signal.SIGINT)
 
 
 def _message(error: Exception, args: argparse.Namespace | None) -> str:
