@@ -171,12 +171,7 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
     config = json.loads((checkpoint / "config.json").read_text())
     assert config["type"] == policy_type and "observation.state" not in config["input_features"]
     assert config.get("time_input", False) is extra.get("time_input", policy_type == "act_hand_relative")
-    evaluate = [sys.executable, "-m", "lerobot_tavis.cli", "eval", "--policy", str(checkpoint), "--device", "cpu",
-                "--tasks", "conditional_pick", "--splits", "id", "--episodes", "1", "--workers", "1",
-                "--batch-size", "1", "--episode-length-s", "1", "--film-episodes", "0", "--out", str(tmp_path / "eval")]
-    subprocess.run(evaluate, check=True, capture_output=True, env=env, timeout=600)
-    (cell,) = json.loads((tmp_path / "eval" / "results.json").read_text())["cells"]
-    assert (cell["task"], cell["n"]) == ("conditional_pick", 1)
+    _one_short_episode(checkpoint, tmp_path / "eval", env)
 
 
 def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_root, tmp_path):
@@ -197,12 +192,7 @@ def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_roo
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
     assert (config["type"], config["time_input"], config["state_input"]) == ("diffusion_hand_relative", True, "none")
-    evaluate = [sys.executable, "-m", "lerobot_tavis.cli", "eval", "--policy", str(checkpoint), "--device", "cpu",
-                "--tasks", "conditional_pick", "--splits", "id", "--episodes", "1", "--workers", "1",
-                "--batch-size", "1", "--episode-length-s", "1", "--film-episodes", "0", "--out", str(tmp_path / "eval")]
-    subprocess.run(evaluate, check=True, capture_output=True, env=env, timeout=600)
-    (cell,) = json.loads((tmp_path / "eval" / "results.json").read_text())["cells"]
-    assert (cell["task"], cell["n"]) == ("conditional_pick", 1)
+    _one_short_episode(checkpoint, tmp_path / "eval", env)
 
 
 def test_pi0_presets_say_clearly_what_is_missing_offline(tmp_path):
@@ -256,3 +246,13 @@ def test_presets_command_lists_and_locates(capsys):
     assert capsys.readouterr().out.split() == preset_names()
     main(["presets", "pi0_fixed_wrist"])
     assert capsys.readouterr().out.strip() == str(preset_path("pi0_fixed_wrist"))
+
+
+def _one_short_episode(checkpoint, out, env) -> None:
+    """`tavis eval` plays one one-second conditional_pick episode with `checkpoint` on CPU and reports it."""
+    evaluate = [sys.executable, "-m", "lerobot_tavis.cli", "eval", "--policy", str(checkpoint), "--device", "cpu",
+                "--tasks", "conditional_pick", "--splits", "id", "--episodes", "1", "--workers", "1",
+                "--batch-size", "1", "--episode-length-s", "1", "--film-episodes", "0", "--out", str(out)]
+    subprocess.run(evaluate, check=True, capture_output=True, env=env, timeout=600)
+    (cell,) = json.loads((out / "results.json").read_text())["cells"]
+    assert (cell["task"], cell["n"]) == ("conditional_pick", 1)
