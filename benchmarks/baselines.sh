@@ -11,7 +11,7 @@
 # episodes from seed 1000 of the id split, head_wrist also on ood_spatial and ood_init_pose. Training and evaluation
 # are benchmarks/train_baseline.sh's (`pair`, or `cell` when one condition is left), one recording per (robot, task).
 # A finished condition becomes RESULTS/<robot>/<task>/<condition>/: the `tavis eval` output without videos, the
-# training config (train_config.json), the run's log (log.txt), the model card (model_card.md) and recipe.json (the
+# training config (train_config.json), the run's log (log.txt, each progress bar's last state), the model card (model_card.md) and recipe.json (the
 # recipe, the commit, the machine, the command). That folder is moved into place whole, then its entry is added to
 # BASELINES (`tavis table-add`). A condition whose folder exists is skipped; one whose folder records another recipe
 # stops the command with a message naming it: one table, one recipe. On the machine of an interrupted run, a
@@ -38,7 +38,10 @@ export EVAL_EPISODES=${EVAL_EPISODES:-96} DEVICE=${DEVICE:-cuda} TRAIN_S=${TRAIN
 WORKERS=${WORKERS:-$(nproc)}
 # train_baseline.sh's other settings take their defaults, whatever the environment holds: no cell of the table is
 # trained or evaluated otherwise than the recipe says.
-unset CONDITION ACTIONS STATE_INPUT STATE_NOISE TRAIN_OPTIONS EVAL_OPTIONS EVAL_NAME CHECKPOINTS GPUS FRAME_CACHE SPLITS
+unset CONDITION ACTIONS STATE_INPUT STATE_NOISE TRAIN_OPTIONS EVAL_OPTIONS EVAL_NAME CHECKPOINTS GPUS SPLITS
+# Trainings read their frames from the dataset's frame cache: the samples LeRobot's loader decodes, decoded once
+# instead of at every step, which bounds two trainings side by side on the CPUs (docs/training.md).
+export FRAME_CACHE=on
 CONDITIONS=(head_wrist fixed_wrist)
 cd "$ROOT"
 
@@ -112,7 +115,7 @@ publish() {  # publish ROBOT TASK CONDITION: the evaluation of the last checkpoi
   # the videos stay in WORK; dot-named leftovers (locks, staging copies) are no results
   find "$stage" -mindepth 1 -depth \( -type d -name 'videos*' -o -name '.*' \) -exec rm -rf {} +
   cp "$checkpoint/pretrained_model/train_config.json" "$stage/train_config.json"
-  cp "$work/cell_$3.log" "$stage/log.txt"
+  awk -F'\r' '{print $NF}' "$work/cell_$3.log" > "$stage/log.txt"  # a progress bar's redraws: its last state
   tavis push-policy "$checkpoint/pretrained_model" --repo-id "$HUB_OWNER/act_hand_relative_$1_$2_$3" \
     --results "$stage/results.json" --out "$work/model_$3" > /dev/null
   cp "$work/model_$3/README.md" "$stage/model_card.md"
