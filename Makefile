@@ -1,5 +1,6 @@
 # Two entry points for a fresh machine: `make demo` and `make test`. Both create .venv with Python 3.12 when
-# missing and install the package (editable, with its extras) into it.
+# missing and install the package (editable, with its extras) into it, with uv: the same packages from PyPI as pip
+# would install, downloaded and unpacked in parallel.
 
 VENV := .venv
 STAMP := $(VENV)/.installed
@@ -27,13 +28,13 @@ ifeq ($(CPU),1)
 endif
 	@$(MAKE) --no-print-directory system-deps
 	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
-	$(VENV)/bin/python -m pip install --upgrade pip
+	$(VENV)/bin/python -m pip install --upgrade pip uv
 ifeq ($(CPU),1)
 	$(VENV)/bin/python -m pip install --index-url $(TORCH_CPU_INDEX) $(TORCH_CPU_PACKAGES) \
 		|| { echo "CPU=1: PyTorch's CPU wheels could not be installed from $(TORCH_CPU_INDEX) (PyPI has none" \
 			"for Linux); without CPU=1, PyPI's CUDA build runs on a CPU as well"; exit 1; }
 endif
-	$(VENV)/bin/python -m pip install -e '.[dev]'
+	$(VENV)/bin/python -m uv pip install --python $(VENV)/bin/python -e '.[dev]'
 	touch $(STAMP)
 
 # Headless OpenGL for MuJoCo (EGL on Mesa); Xvfb, the virtual display the viewer's test (and `xvfb-run -a
