@@ -5,6 +5,7 @@
 #   benchmarks/baselines.sh table             every robot and task not yet complete; one (robot, task) per pair of
 #                                             GPUs at once (4 GPUs: two), each condition on a GPU of its own; then
 #                                             `tavis table` writes baselines.md and baselines.png beside BASELINES
+#                                             and the table into the README.md there (docs/results/README.md)
 #
 # One recipe for every cell: the `act_hand_relative_<condition>_compact` presets, EPISODES (160) demonstrations,
 # STEPS (3200) steps of BATCH (128), training seed SEED (1000), the last checkpoint evaluated on EVAL_EPISODES (96)
@@ -222,7 +223,8 @@ case "${1:-}" in
     done
     status=0
     for pid in "${pids[@]}"; do wait "$pid" || status=1; done
-    tavis table --baselines "$BASELINES" --out "$(dirname "$BASELINES")"  # the table as far as it goes
+    readme=$(dirname "$BASELINES")/README.md  # the table as far as it goes, also at the top of the results' README
+    tavis table --baselines "$BASELINES" --out "$(dirname "$BASELINES")" $([ -f "$readme" ] && echo --readme "$readme")
     exit "$status"
     ;;
   *)

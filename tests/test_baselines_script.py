@@ -19,7 +19,7 @@ TAVIS = LOG_CALL + """value() {  # the argument after $FLAG
 case $1 in
   record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
   presets) python3 -m lerobot_tavis.cli presets "$2" ;;  # the real file: train_baseline reads its budget
-  convert|curve) ;;
+  convert|curve|cache-frames) ;;
   eval) out=${@: -1}; mkdir -p "$out/tavis_head__id/videos" "$out/.tavis_head__id.chunks"
     format='{"cells": [{"task": "%s", "split": "id", "successes": 1, "n": 2}], '
     format+='"sources": [{"robots": ["%s"], "camera_modes": ["%s"]}]}'
@@ -71,6 +71,8 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
     for train in _calls(tmp_path, "lerobot-train"):  # the recipe, whatever TRAIN_OPTIONS the environment held
         assert " --steps=20 --save_freq=20 --batch_size=128" in train and "--steps=1 " not in train
         assert "--seed=1000 " in train and "--env.robot=gr1t2 " in train
+    caches = sorted(call.split()[2] for call in _calls(tmp_path, "tavis cache-frames"))  # trainings read frames there
+    assert caches == [str(work / "dataset_fixed_wrist"), str(work / "dataset_head_wrist")]
     evals = {call.split("--camera-mode ")[1].split()[0]: call for call in _calls(tmp_path, "tavis eval")}
     assert "--splits id ood_spatial ood_init_pose --episodes 96 --seed 1000" in evals["head_wrist"]
     assert "--splits id --episodes 96 --seed 1000" in evals["fixed_wrist"]

@@ -18,6 +18,7 @@ from pathlib import Path
 from lerobot_tavis.atomic import write_text
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
+from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.baselines import BASELINES_PATH, CONDITIONS, Entry, read_entries, read_results
 from lerobot_tavis.metrics.stats import wilson_interval
 
@@ -133,15 +134,33 @@ def targets(cells: dict, robot: str) -> list[str]:
     return lines + [f"- Target, the four search tasks pooled, head + wrists ahead of fixed + wrists: {search_line}."]
 
 
-def table_markdown(entries: list[Entry], root: Path) -> str:
+def table_body(entries: list[Entry], root: Path) -> str:
+    """The table below its title: what a cell holds, then each robot's table and targets."""
     cells = measured_cells(entries, root)
-    lines = ["# The baselines table", "",
-             "Success on 96 episodes per cell unless the entry's evaluation says otherwise, with Wilson 95% "
+    lines = ["Success on 96 episodes per cell unless the entry's evaluation says otherwise, with Wilson 95% "
              "intervals; GALT: median gaze-action lead time of the successful episodes. One single-task policy "
              "per robot, task and condition (docs/results/baselines.json). Paper: " + PAPER_SOURCE + ".", ""]
     for robot in ROBOTS:
         lines += robot_table(cells, robot) + [""]
     return "\n".join(lines)
+
+
+def table_markdown(entries: list[Entry], root: Path) -> str:
+    return "# The baselines table\n\n" + table_body(entries, root)
+
+
+README_BEGIN = "<!-- the baselines table: written by `tavis table --readme`, do not edit -->"
+README_END = "<!-- end of the baselines table -->"
+
+
+def with_table(readme: str, body: str, path: Path) -> str:
+    """`readme` with the text between its two marker lines replaced by `body`."""
+    head, begin, rest = readme.partition(README_BEGIN + "\n")
+    _, end, tail = rest.partition(README_END + "\n")
+    if not begin or not end:
+        raise InputError(f"{path}: no table markers: put the line '{README_BEGIN}' and, below it, the line "
+                             f"'{README_END}' where the table goes")
+    return f"{head}{begin}{body}{end}{tail}"
 
 
 def table_plot(entries: list[Entry], root: Path, path: Path) -> Path:
@@ -200,15 +219,23 @@ class TableConfig:
                         "directory)")
     out_dir: Path | None = option(None, "also write baselines.md and baselines.png into this folder (default: print "
                                   "the table only)", flag="--out")
+    readme: Path | None = option(None, "also put the table into this Markdown file, between its two marker lines "
+                                 f"('{README_BEGIN}' and '{README_END}') (default: none)")
 
 
 def run_table(cfg: TableConfig) -> list[str]:
     entries = read_entries(cfg.baselines, cfg.root)
     text = table_markdown(entries, cfg.root)
-    if cfg.out_dir is None:
-        return [text]
-    return [str(write_text(cfg.out_dir / "baselines.md", text)),
-            str(table_plot(entries, cfg.root, cfg.out_dir / "baselines.png"))]
+    written = []
+    if cfg.readme is not None:
+        if not cfg.readme.is_file():
+            raise PathNotFoundError(f"--readme {cfg.readme}: no such file")
+        readme = with_table(cfg.readme.read_text(), table_body(entries, cfg.root), cfg.readme)
+        written.append(str(write_text(cfg.readme, readme)))
+    if cfg.out_dir is not None:
+        written += [str(write_text(cfg.out_dir / "baselines.md", text)),
+                    str(table_plot(entries, cfg.root, cfg.out_dir / "baselines.png"))]
+    return written or [text]
 
 
 # The wrist-only ablation of the paper's TAVIS-Hands study: a TAVIS-Head policy with and without active vision

@@ -9,7 +9,8 @@ import pytest
 
 from lerobot_tavis.errors import InputError, PathNotFoundError
 from lerobot_tavis.eval.baselines import BASELINES_PATH, Entry, add_entry, read_entries
-from lerobot_tavis.eval.baselines_table import PAPER_HANDS_ID, ablation_markdown, table_markdown, table_plot
+from lerobot_tavis.eval.baselines_table import (PAPER_HANDS_ID, README_BEGIN, README_END, ablation_markdown, table_body,
+                                               table_markdown, table_plot, with_table)
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -21,6 +22,21 @@ def test_the_repositorys_baselines_file_names_existing_results_of_its_robot_task
         results = json.loads((REPO / entry.results).read_text())
         assert {(cell["task"], cell["split"]) for cell in results["cells"]} >= {(entry.task, "id")}
         assert entry.policy == f"act_hand_relative_{entry.camera_mode}_compact"
+
+
+def test_the_results_readme_shows_the_table_of_the_repositorys_baselines_file():
+    readme = (REPO / "docs" / "results" / "README.md").read_text()
+    table = table_body(read_entries(REPO / BASELINES_PATH, REPO), REPO)
+    assert f"{README_BEGIN}\n{table}{README_END}\n" in readme, "run: tavis table --readme docs/results/README.md"
+
+
+def test_the_table_replaces_only_the_text_between_the_markers_and_refuses_a_file_without_them():
+    readme = f"# Results\n\nabove\n{README_BEGIN}\nan old table\n{README_END}\nbelow\n"
+    updated = with_table(readme, "the table\n", Path("README.md"))
+    assert updated == f"# Results\n\nabove\n{README_BEGIN}\nthe table\n{README_END}\nbelow\n"
+    assert with_table(updated, "the table\n", Path("README.md")) == updated
+    with pytest.raises(InputError, match="README.md: no table markers"):
+        with_table("# Results\n", "the table\n", Path("README.md"))
 
 
 def _results(root: Path, name: str, robot: str, mode: str, *cells: tuple) -> str:
