@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The baselines table (docs/results/README.md) in one command, for one cell or all of them; run it again to resume.
 #
-#   benchmarks/baselines.sh cell ROBOT TASK   both conditions (head_wrist, fixed_wrist) of one robot and task
+#   benchmarks/baselines.sh cell ROBOT TASK   both conditions (head_wrist, fixed_wrist) of one robot and task, then
+#                                             the table as `table` writes it
 #   benchmarks/baselines.sh table             every robot and task not yet complete; one (robot, task) per pair of
 #                                             GPUs at once (4 GPUs: two), each condition on a GPU of its own; then
 #                                             `tavis table` writes baselines.md and baselines.png beside BASELINES
@@ -174,6 +175,12 @@ cell() {  # cell ROBOT TASK
   return "$status"
 }
 
+write_table() {  # the table as far as it goes, beside BASELINES and at the top of the README.md there if any
+  local readme
+  readme=$(dirname "$BASELINES")/README.md
+  tavis table --baselines "$BASELINES" --out "$(dirname "$BASELINES")" $([ -f "$readme" ] && echo --readme "$readme")
+}
+
 check_cell() {  # check_cell ROBOT TASK: both known, else exit 2
   local robots tasks
   robots=$(python3 -c "from lerobot_tavis.envs.robots import robot_names; print(*robot_names())")
@@ -189,7 +196,10 @@ case "${1:-}" in
     if (( $# != 3 )); then echo "usage: $0 cell ROBOT TASK" >&2; exit 2; fi
     python3 -c "$RECIPE" > /dev/null  # a setting that is no number stops here
     check_cell "$2" "$3"
-    cell "$2" "$3"
+    status=0
+    cell "$2" "$3" || status=$?
+    write_table
+    exit "$status"
     ;;
   table)
     python3 -c "$RECIPE" > /dev/null
@@ -223,8 +233,7 @@ case "${1:-}" in
     done
     status=0
     for pid in "${pids[@]}"; do wait "$pid" || status=1; done
-    readme=$(dirname "$BASELINES")/README.md  # the table as far as it goes, also at the top of the results' README
-    tavis table --baselines "$BASELINES" --out "$(dirname "$BASELINES")" $([ -f "$readme" ] && echo --readme "$readme")
+    write_table
     exit "$status"
     ;;
   *)

@@ -71,6 +71,7 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
     for train in _calls(tmp_path, "lerobot-train"):  # the recipe, whatever TRAIN_OPTIONS the environment held
         assert " --steps=20 --save_freq=20 --batch_size=128" in train and "--steps=1 " not in train
         assert "--seed=1000 " in train and "--env.robot=gr1t2 " in train
+    assert "| TAVIS-Head | clutter_pick_cube | 50.0% [" in (tmp_path / "baselines.md").read_text()  # the table too
     caches = sorted(call.split()[2] for call in _calls(tmp_path, "tavis cache-frames"))  # trainings read frames there
     assert caches == [str(work / "dataset_fixed_wrist"), str(work / "dataset_head_wrist")]
     evals = {call.split("--camera-mode ")[1].split()[0]: call for call in _calls(tmp_path, "tavis eval")}
