@@ -4,7 +4,8 @@
 #   benchmarks/baselines.sh cell ROBOT TASK   both conditions (head_wrist, fixed_wrist) of one robot and task, then
 #                                             the table as `table` writes it
 #   benchmarks/baselines.sh table             every robot and task not yet complete; one (robot, task) per pair of
-#                                             GPUs at once (4 GPUs: two), each condition on a GPU of its own; then
+#                                             GPUs at once (4 GPUs: two), each condition on a GPU of its own, the
+#                                             pair's next cell recorded, converted and cached meanwhile; then
 #                                             `tavis table` writes baselines.md and baselines.png beside BASELINES
 #                                             and the table into the README.md there (docs/results/README.md)
 #
@@ -133,6 +134,23 @@ trained() {  # trained ROBOT TASK CONDITION: WORK holds the checkpoint of its tr
   (( 10#$(basename "$last") == STEPS )) && [ -f "$last/pretrained_model/model.safetensors" ]
 }
 
+scratch() {  # scratch ROBOT TASK: WORK's folder of the cell, emptied if another recipe made it, with this recipe.json
+  local work="$WORK/$1_$2"
+  if ! python3 -c "$RECIPE" "$work/recipe.json" 2> /dev/null; then rm -rf "$work"; fi
+  mkdir -p "$work"
+  python3 -c "$RECIPE" write "$work/recipe.json" "benchmarks/baselines.sh cell $1 $2"
+}
+
+prepare() {  # prepare ROBOT TASK: the recording, datasets and frame caches of its unfinished conditions, at a low
+  # CPU priority: `table` runs it for a GPU pair's next cell while the pair trains, which leaves the CPUs idle
+  local condition work="$WORK/$1_$2"
+  scratch "$1" "$2"
+  for condition in "${CONDITIONS[@]}"; do
+    complete "$1" "$2" "$condition" && continue
+    ROBOT=$1 TASK=$2 WORK=$work CONDITION=$condition nice -n 10 "$HERE/train_baseline.sh" prepare
+  done
+}
+
 cell() {  # cell ROBOT TASK
   local robot=$1 task=$2 work="$WORK/$1_$2" condition status=0 todo=() train=() gpus=() index=0
   for condition in "${CONDITIONS[@]}"; do
@@ -141,10 +159,8 @@ cell() {  # cell ROBOT TASK
   done
   if (( ${#todo[@]} == 0 )); then echo "baselines: $robot $task complete, skipped"; return 0; fi
   # The scratch folder of another recipe is removed. In that of an interrupted run, a finished training is kept
-  # and evaluated (`tavis eval` resumes its chunks); one cut short is trained again.
-  if ! python3 -c "$RECIPE" "$work/recipe.json" 2> /dev/null; then rm -rf "$work"; fi
-  mkdir -p "$work"
-  python3 -c "$RECIPE" write "$work/recipe.json" "benchmarks/baselines.sh cell $robot $task"
+  # and evaluated (`tavis eval` resumes its chunks); one cut short is trained again; datasets and caches are kept.
+  scratch "$robot" "$task"
   for condition in "${todo[@]}"; do
     rm -rf "$work/eval_$condition"/*.running  # the mark of an evaluation under way, left by a killed one
     if ! trained "$robot" "$task" "$condition"; then
@@ -220,13 +236,21 @@ case "${1:-}" in
     echo "baselines: ${#cells[@]} (robot, task) cells to run, $slots at once, on GPUs: ${gpus[*]:-none}"
     pids=()
     for (( slot = 0; slot < slots; slot++ )); do
-      ( status=0
+      ( status=0 ahead=""
         if (( ${#gpus[@]} > 1 )); then export CUDA_VISIBLE_DEVICES=${gpus[2 * slot]},${gpus[2 * slot + 1]}
         elif (( ${#gpus[@]} == 1 )); then export CUDA_VISIBLE_DEVICES=${gpus[0]}; fi
+        export WORKERS=$(( WORKERS / slots > 1 ? WORKERS / slots : 1 ))
         for (( i = slot; i < ${#cells[@]}; i += slots )); do
           read -r robot task <<< "${cells[i]}"
-          WORKERS=$(( WORKERS / slots > 1 ? WORKERS / slots : 1 )) "$HERE/baselines.sh" cell "$robot" "$task" \
-            || status=1
+          [ -z "$ahead" ] || wait "$ahead" || true  # its failure leaves the cell's own `data` to do it again
+          ahead=""
+          if (( i + slots < ${#cells[@]} )); then  # the next cell's CPU work, while this one trains
+            read -r next_robot next_task <<< "${cells[i + slots]}"
+            mkdir -p "$WORK"
+            prepare "$next_robot" "$next_task" > "$WORK/prepare_${next_robot}_$next_task.log" 2>&1 &
+            ahead=$!
+          fi
+          "$HERE/baselines.sh" cell "$robot" "$task" || status=1
         done
         exit "$status" ) &
       pids+=($!)

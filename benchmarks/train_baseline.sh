@@ -2,7 +2,7 @@
 # One baseline cell within 30 minutes on one GPU: demonstrations -> dataset -> compact policy -> evaluation
 # of every checkpoint (96 episodes each, Wilson intervals and GALT by `tavis eval`'s report).
 #
-#   benchmarks/train_baseline.sh pair|cell|data|train|eval|overfit
+#   benchmarks/train_baseline.sh pair|cell|data|prepare|train|eval|overfit
 #
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
 # fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
@@ -54,7 +54,10 @@
 #   the slot; POLICY=diffusion, not yet timed on a GPU: 1500 s), the checkpoints evaluated at low CPU priority as
 #   they appear, and those left after training ends side by side.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
-#   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0).
+#   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0), unless WORK already holds
+#   that conversion of that recording (its meta/tavis_conversion.json says so): then the dataset is kept.
+# - prepare: data, then (FRAME_CACHE=on) the dataset's frame cache: the CPU work `train` needs done, which can run
+#   ahead while another cell trains.
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset (ACTIONS=hand_relative:
 #   `<POLICY>_hand_relative_<CONDITION>_compact`); decodes with torchcodec when FFmpeg's libraries can be found (PyAV's
 #   bundled copy, tools/pyav_ffmpeg.sh), else with PyAV. A run whose logged loss becomes NaN (float16 AMP
@@ -200,6 +203,22 @@ record() {  # the demonstrations, once: every condition of TASK converts the sam
     --episodes-per-task "$EPISODES" --workers "$WORKERS" --out "$WORK/raw"
 }
 
+converted() {  # converted DATASET_DIR: it holds WORK's recording converted as `convert` below converts it
+  python3 - "$1" "$WORK/raw" "$SIZE" "$CAMERAS" "${#NECK[@]}" <<'PY'
+import json, os, sys
+dataset, raw, size, cameras, zero_neck = sys.argv[1:]
+try:
+    log = json.load(open(os.path.join(dataset, "meta", "tavis_conversion.json")))
+    recorded = {entry["file"] for entry in json.load(open(os.path.join(raw, "manifest.json")))["episodes"]}
+    wanted = {"raw_dir": os.path.abspath(raw), "fps": 20, "image_size": [int(n) for n in size.split("x")],
+              "cameras": cameras.split(","), "zero_neck": zero_neck == "1"}
+    same = {key: log[key] for key in wanted} == wanted and {e["raw_file"] for e in log["episodes"]} == recorded
+except (OSError, ValueError, KeyError, TypeError):
+    same = False
+sys.exit(0 if same else 1)
+PY
+}
+
 convert() {  # convert RAW_DIR DATASET_DIR
   tavis convert "$1" --repo-id "local/$(basename "$2")" --root "$2" --fps 20 --image-size "$SIZE" \
     --cameras "$CAMERAS" "${NECK[@]}" --workers "$WORKERS" --overwrite
@@ -250,6 +269,10 @@ PY
   echo "$copy"
 }
 
+cache_frames() {  # cache_frames DATASET_DIR: written once per dataset; later calls find it up to date
+  tavis cache-frames "$1" --workers "$WORKERS" --video-backend "$BACKEND"
+}
+
 train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]: fails with 3, the run stopped, at a NaN loss
   local dataset=$1 out=$2 status=0 config
   shift 2
@@ -260,8 +283,8 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]: fails wi
       --dynamo_backend no -m lerobot.scripts.lerobot_train)
   fi
   export TAVIS_FRAME_CACHE=0
-  if [ "$FRAME_CACHE" = on ]; then  # written once per dataset; later calls find it up to date
-    tavis cache-frames "$dataset" --workers "$WORKERS" --video-backend "$BACKEND"
+  if [ "$FRAME_CACHE" = on ]; then
+    cache_frames "$dataset"
     TAVIS_FRAME_CACHE=1
   fi
   "${launch[@]}" --config_path="$config" \
@@ -326,7 +349,15 @@ case "${1:-}" in
     ;;
   data)
     record
-    time convert "$WORK/raw" "$WORK/dataset_$CONDITION"
+    if converted "$WORK/dataset_$CONDITION"; then
+      echo "train_baseline: $WORK/dataset_$CONDITION holds this recording's conversion: kept"
+    else
+      time convert "$WORK/raw" "$WORK/dataset_$CONDITION"
+    fi
+    ;;
+  prepare)
+    "$0" data
+    if [ "$FRAME_CACHE" = on ]; then choose_video_backend; cache_frames "$WORK/dataset_$CONDITION"; fi
     ;;
   train)
     choose_video_backend
@@ -379,7 +410,7 @@ PY
     evaluate "$WORK/overfit/train_$RUN/checkpoints/last" "$WORK/overfit/eval_$RUN/new_seeds" 1000 8
     ;;
   *)
-    echo "usage: $0 pair|cell|data|train|eval|overfit" >&2
+    echo "usage: $0 pair|cell|data|prepare|train|eval|overfit" >&2
     exit 2
     ;;
 esac

@@ -17,9 +17,20 @@ LOG_CALL = 'echo "$(basename "$0") $* | gpu=${CUDA_VISIBLE_DEVICES:-} egl=${MUJO
 TAVIS = LOG_CALL + """value() {  # the argument after $FLAG
   local previous; for arg in "$@"; do [ "${previous:-}" = "$FLAG" ] && echo "$arg"; previous=$arg; done; }
 case $1 in
-  record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
+  record) out=${@: -1}; mkdir -p "$out"; echo '{"episodes": []}' > "$out/manifest.json" ;;
   presets) python3 -m lerobot_tavis.cli presets "$2" ;;  # the real file: train_baseline reads its budget
-  convert|curve|cache-frames) ;;
+  convert) "$PYTHON" - "$@" <<'PY'  # the conversion log alone: what tells a later call the dataset is current
+import json, os, sys
+raw, args = sys.argv[2], sys.argv[3:]
+value = lambda flag: args[args.index(flag) + 1]
+log = {"raw_dir": os.path.abspath(raw), "fps": int(value("--fps")),
+       "image_size": [int(n) for n in value("--image-size").split("x")], "cameras": value("--cameras").split(","),
+       "zero_neck": "--zero-neck" in args, "episodes": []}
+os.makedirs(os.path.join(value("--root"), "meta"), exist_ok=True)
+json.dump(log, open(os.path.join(value("--root"), "meta", "tavis_conversion.json"), "w"))
+PY
+    ;;
+  curve|cache-frames) ;;
   eval) out=${@: -1}; mkdir -p "$out/tavis_head__id/videos" "$out/.tavis_head__id.chunks"
     format='{"cells": [{"task": "%s", "split": "id", "successes": 1, "n": 2}], '
     format+='"sources": [{"robots": ["%s"], "camera_modes": ["%s"]}]}'
@@ -127,17 +138,25 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
 
 
 def test_the_table_runs_two_cells_at_once_on_four_gpus_and_leaves_a_failed_training_out(tmp_path):
-    run = _baselines(tmp_path, "table", ROBOTS="gr1t2", TASKS="conditional_pick clutter_pick_cube",
+    run = _baselines(tmp_path, "table", ROBOTS="gr1t2", TASKS="conditional_pick clutter_pick_cube peeking_box",
                      CUDA_VISIBLE_DEVICES="0,1,2,3")
     assert run.returncode == 0, run.stderr
-    assert "2 (robot, task) cells to run, 2 at once, on GPUs: 0 1 2 3" in run.stdout
+    assert "3 (robot, task) cells to run, 2 at once, on GPUs: 0 1 2 3" in run.stdout
     trains = sorted((call.split("--env.task=")[1].split()[0], call.split("/train_")[1].split()[0],
                      call.split(" | ")[1]) for call in _calls(tmp_path, "lerobot-train"))
     assert trains == [("clutter_pick_cube", "fixed_wrist", "gpu=3 egl=3"),
                       ("clutter_pick_cube", "head_wrist", "gpu=2 egl=2"),
                       ("conditional_pick", "fixed_wrist", "gpu=1 egl=1"),
-                      ("conditional_pick", "head_wrist", "gpu=0 egl=0")]
-    assert len(json.loads((tmp_path / "baselines.json").read_text())) == 4
+                      ("conditional_pick", "head_wrist", "gpu=0 egl=0"),
+                      ("peeking_box", "fixed_wrist", "gpu=1 egl=1"),
+                      ("peeking_box", "head_wrist", "gpu=0 egl=0")]
+    # peeking_box, the first pair's second cell, was recorded, converted and cached while conditional_pick trained;
+    # its own run kept those datasets: one recording per cell, one conversion per condition.
+    assert (tmp_path / "work" / "prepare_gr1t2_peeking_box.log").is_file()
+    assert sorted(call.split()[2].split("/work/")[1] for call in _calls(tmp_path, "tavis convert")) == [
+        f"gr1t2_{task}/raw" for task in ("clutter_pick_cube", "conditional_pick", "peeking_box") for _ in range(2)]
+    assert len(_calls(tmp_path, "tavis record")) == 3
+    assert len(json.loads((tmp_path / "baselines.json").read_text())) == 6
     table = (tmp_path / "baselines.md").read_text()  # rendered at the end
     assert ("| TAVIS-Head | clutter_pick_cube | 50.0% [9.5, 90.5] | 50.0% [9.5, 90.5] | not run | not run | - | - |"
             in table)
