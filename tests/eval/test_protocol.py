@@ -209,8 +209,9 @@ def test_lerobot_options_pass_through_to_the_policy_and_the_env(tmp_path, monkey
 
 @pytest.mark.parametrize("workers", [1, 2])
 def test_an_unknown_policy_option_names_the_field(tmp_path, diffusion_checkpoint, workers):
-    """Refused by the first job to read the checkpoint's config, in this process or in a worker."""
-    cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("id",), n_episodes=1,
+    """Refused by the first job to read the checkpoint's config, in this process or in a worker (one job: one
+    worker process loads LeRobot)."""
+    cfg = ProtocolConfig(out_dir=tmp_path / "eval", tasks=("conditional_pick",), splits=("id",), n_episodes=1,
                          image_size=(32, 48), policy_path=str(diffusion_checkpoint), policy_options=(("denoise", 3),),
                          workers=workers)
     with pytest.raises(ValueError, match="--policy-option denoise: the diffusion policy has no such field"):
