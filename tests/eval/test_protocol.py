@@ -294,7 +294,8 @@ def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first
 
 
 def test_filming_changes_no_result_and_zero_films_nothing(tmp_path, diffusion_checkpoint):
-    tasks = ("peeking_box", "occluded_reach")
+    """One task's batch of two async envs, both filmed or neither (each task's first chunk is filmed alike)."""
+    tasks = ("peeking_box",)
     films = _tiny_policy_cell(diffusion_checkpoint, tmp_path / "films", "tavis_hands", tasks, batch_size=2,
                               film_episodes=2)
     none = _tiny_policy_cell(diffusion_checkpoint, tmp_path / "none", "tavis_hands", tasks, batch_size=2,
@@ -302,8 +303,8 @@ def test_filming_changes_no_result_and_zero_films_nothing(tmp_path, diffusion_ch
     assert films[0] == none[0]  # the episode logs
     assert [t["metrics"]["successes"] for t in films[1]["per_task"]] == [
         t["metrics"]["successes"] for t in none[1]["per_task"]]
-    assert [len(t["metrics"]["video_paths"]) for t in films[1]["per_task"]] == [2, 2]
-    assert [t["metrics"]["video_paths"] for t in none[1]["per_task"]] == [[], []]
+    assert [len(t["metrics"]["video_paths"]) for t in films[1]["per_task"]] == [2]
+    assert [t["metrics"]["video_paths"] for t in none[1]["per_task"]] == [[]]
     assert not (tmp_path / "none" / "tavis_hands__id" / "videos").exists()
 
 
