@@ -125,7 +125,12 @@ def test_zero_neck_conversion_for_the_fixed_camera_presets(conditional_pick_demo
     assert np.any(action[:, canonical.LEFT.position] != 0)
 
 
-def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_eval(dataset_root, tmp_path):
+def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_eval(dataset_root, tmp_path,
+                                                                                     monkeypatch):
+    """lerobot-train's own process (the plugin found as LeRobot finds it), then lerobot-eval's eval_main in this
+    process (tests/eval/test_protocol.py runs lerobot-eval's console script)."""
+    from lerobot.scripts import lerobot_eval
+
     env = {**os.environ, "MUJOCO_GL": "egl"}
     preset = preset_path("diffusion_head_only")
     train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={preset}",
@@ -136,11 +141,13 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
     (periodic,) = [json.loads(line) for line in (tmp_path / "train" / "episodes.jsonl").read_text().splitlines()]
     assert periodic["task"] == "conditional_pick" and periodic["camera_mode"] == "head_only"
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
-    evaluate = [sys.executable, "-m", "lerobot.scripts.lerobot_eval", f"--policy.path={checkpoint}",
-                "--policy.device=cpu", "--env.type=tavis", "--env.task=conditional_pick",
-                f"--env.image_size=[{TINY[0]},{TINY[1]}]", "--env.episode_length_s=1", "--eval.n_episodes=1",
-                "--eval.batch_size=1", "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'eval'}"]
-    subprocess.run(evaluate, check=True, capture_output=True, env=env, timeout=600)
+    monkeypatch.setattr("sys.argv", [
+        "lerobot-eval", f"--policy.path={checkpoint}", "--policy.device=cpu", "--env.type=tavis",
+        "--env.task=conditional_pick", f"--env.image_size=[{TINY[0]},{TINY[1]}]", "--env.episode_length_s=1",
+        "--eval.n_episodes=1", "--eval.batch_size=1", "--eval.use_async_envs=false",
+        f"--output_dir={tmp_path / 'eval'}"])
+    monkeypatch.setenv("HF_HUB_OFFLINE", "1")
+    lerobot_eval.eval_main()
     info = json.loads((tmp_path / "eval" / "eval_info.json").read_text())
     assert info["overall"]["n_episodes"] == 1
 
@@ -171,7 +178,7 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
     config = json.loads((checkpoint / "config.json").read_text())
     assert config["type"] == policy_type and "observation.state" not in config["input_features"]
     assert config.get("time_input", False) is extra.get("time_input", policy_type == "act_hand_relative")
-    _one_short_episode(checkpoint, tmp_path / "eval", env)
+    _one_short_episode(checkpoint, tmp_path / "eval")
 
 
 def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_root, tmp_path):
@@ -192,7 +199,7 @@ def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_roo
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
     assert (config["type"], config["time_input"], config["state_input"]) == ("diffusion_hand_relative", True, "none")
-    _one_short_episode(checkpoint, tmp_path / "eval", env)
+    _one_short_episode(checkpoint, tmp_path / "eval")
 
 
 def test_pi0_presets_say_clearly_what_is_missing_offline(tmp_path):
@@ -248,11 +255,11 @@ def test_presets_command_lists_and_locates(capsys):
     assert capsys.readouterr().out.strip() == str(preset_path("pi0_fixed_wrist"))
 
 
-def _one_short_episode(checkpoint, out, env) -> None:
-    """`tavis eval` plays one one-second conditional_pick episode with `checkpoint` on CPU and reports it."""
-    evaluate = [sys.executable, "-m", "lerobot_tavis.cli", "eval", "--policy", str(checkpoint), "--device", "cpu",
-                "--tasks", "conditional_pick", "--splits", "id", "--episodes", "1", "--workers", "1",
-                "--batch-size", "1", "--episode-length-s", "1", "--film-episodes", "0", "--out", str(out)]
-    subprocess.run(evaluate, check=True, capture_output=True, env=env, timeout=600)
+def _one_short_episode(checkpoint, out) -> None:
+    """`tavis eval` (in this process) plays one one-second conditional_pick episode with `checkpoint` on CPU and
+    reports it."""
+    main(["eval", "--policy", str(checkpoint), "--device", "cpu", "--tasks", "conditional_pick", "--splits", "id",
+          "--episodes", "1", "--workers", "1", "--batch-size", "1", "--episode-length-s", "1", "--film-episodes", "0",
+          "--out", str(out)])
     (cell,) = json.loads((out / "results.json").read_text())["cells"]
     assert (cell["task"], cell["n"]) == ("conditional_pick", 1)

@@ -76,21 +76,26 @@ def test_the_window_follows_a_camera_and_queues_key_presses(virtual_display):
     assert shown["following"] and shown["keys"] == [[32], []]
 
 
-@pytest.fixture(scope="module")
-def act_checkpoint(conditional_pick_demonstration, tmp_path_factory):
-    """An ACT checkpoint of the compact head + wrists preset after one training step on one demonstration."""
-    from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
-    from lerobot_tavis.policy_configs import preset_path
+POLICY_IMAGE_SIZE = (48, 64)
 
-    scratch = tmp_path_factory.mktemp("view_policy")
-    root = convert(ConvertConfig(conditional_pick_demonstration, "local/tiny", scratch / "dataset",
-                                 image_size=(120, 160), cameras=("head", "left_wrist", "right_wrist")), progress=False)
-    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train",
-             f"--config_path={preset_path('act_head_wrist_compact')}", "--dataset.repo_id=local/tiny",
-             f"--dataset.root={root}", "--env.task=conditional_pick", "--policy.device=cpu", "--steps=1",
-             "--save_freq=1", "--batch_size=2", "--num_workers=0", f"--output_dir={scratch / 'train'}"]
-    subprocess.run(train, check=True, capture_output=True, env={**os.environ, "MUJOCO_GL": "egl"}, timeout=600)
-    return scratch / "train" / "checkpoints" / "last" / "pretrained_model"
+
+@pytest.fixture(scope="module")
+def act_checkpoint(tmp_path_factory):
+    """A small ACT checkpoint (random weights; what it acts on, not how well, is tested here) that reads the head
+    and wrist cameras at POLICY_IMAGE_SIZE, saved as lerobot-train saves one."""
+    from lerobot.policies.act.configuration_act import ACTConfig
+    from lerobot.policies.factory import make_policy, make_pre_post_processors
+
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
+
+    path = tmp_path_factory.mktemp("view_policy") / "pretrained_model"
+    config = ACTConfig(pretrained_backbone_weights=None, device="cpu", push_to_hub=False, dim_model=32,
+                       dim_feedforward=64, n_heads=2, chunk_size=20, n_action_steps=10)
+    policy = make_policy(config, env_cfg=TavisEnvConfig(camera_mode="head_wrist", image_size=POLICY_IMAGE_SIZE))
+    policy.save_pretrained(path)
+    for processor in make_pre_post_processors(config, dataset_stats=None):
+        processor.save_pretrained(path)
+    return path
 
 
 def test_a_policy_checkpoint_drives_the_viewer(virtual_display, act_checkpoint):
@@ -105,7 +110,7 @@ def test_a_policy_acts_on_the_env_observations(act_checkpoint):
     from lerobot_tavis.viewer import PolicyDriver
 
     driver = PolicyDriver(act_checkpoint)
-    env = TavisEnv("conditional_pick", "gr1t2", camera_mode="head_wrist", image_size=(120, 160))
+    env = TavisEnv("conditional_pick", "gr1t2", camera_mode="head_wrist", image_size=POLICY_IMAGE_SIZE)
     observation, _ = env.reset(seed=0)
     driver.reset()
     action = driver.act(observation, env.task_description)

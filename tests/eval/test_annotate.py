@@ -11,6 +11,7 @@ from lerobot_tavis.media import iter_mp4, write_mp4
 from lerobot_tavis.overlay import EVENT_COLOURS, Caption, band_height, compose
 
 FPS = 20
+SUCCESS_STEPS, FAILURE_STEPS = 24, 30  # the two filmed episodes' lengths: a video holds one frame more
 
 
 def _record(seed, success, length_steps, gaze=None):
@@ -33,8 +34,9 @@ def _has(region, colour):
 
 
 def _filmed_evaluation(eval_dir):
-    """An evaluation folder as lerobot-eval leaves it: a success (seed 1000) and a failure, both filmed."""
-    records = [_record(1000, True, 40, gaze=0.5), _record(1001, False, 60)]
+    """An evaluation folder as lerobot-eval leaves it: a success (seed 1000, 1.2 s: its gaze at 0.1 s, its grasp at
+    1.1 s) and a failure (1.5 s), both filmed."""
+    records = [_record(1000, True, SUCCESS_STEPS, gaze=0.1), _record(1001, False, FAILURE_STEPS)]
     (eval_dir / "eval_info.json").write_text(json.dumps({"per_task": [
         {"task_group": "tavis_head", "task_id": 0, "metrics": {"successes": [True, False]}}]}))
     (eval_dir / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
@@ -51,7 +53,7 @@ def test_videos_get_a_copy_with_the_episode_events(tmp_path):
     assert all(path in written for path in annotated)
     success_frames, failure_frames = list(iter_mp4(annotated[0])), list(iter_mp4(annotated[1]))
     original = list(iter_mp4(tmp_path / "videos" / "tavis_head_0" / "eval_episode_0.mp4"))
-    assert len(success_frames) == 41 and len(failure_frames) == 61
+    assert len(success_frames) == SUCCESS_STEPS + 1 and len(failure_frames) == FAILURE_STEPS + 1
     band = band_height(original[0].shape[1])
     assert np.abs(success_frames[5][:-band].astype(int) - original[5][:-band]).mean() < 2  # panel untouched
     for colour in ("gaze", "reach", "grasp", "success"):
@@ -69,7 +71,7 @@ def test_annotated_videos_do_not_depend_on_the_number_of_workers(tmp_path):
         _filmed_evaluation(eval_dir)
         written = sorted(path for path in write_report(eval_dir, workers=workers) if path.suffix == ".mp4")
         frames[workers] = [np.stack(list(iter_mp4(path))) for path in written]
-    assert [len(video) for video in frames[1]] == [41, 61]
+    assert [len(video) for video in frames[1]] == [SUCCESS_STEPS + 1, FAILURE_STEPS + 1]
     assert all(np.array_equal(one, two) for one, two in zip(frames[1], frames[2], strict=True))
     assert not list(tmp_path.rglob("*.partial*"))
 

@@ -164,8 +164,8 @@ def test_async_workers_run_at_the_given_niceness_above_this_process(worker_nicen
 
 def test_retargeted_workers_build_the_new_task_in_the_same_processes():
     """`retarget` swaps every started worker's sub-env for the new task's, in the same process and at the same
-    niceness; its episodes are those of a new batch of that task."""
-    fresh = TavisEnvConfig(task="conditional_pick", image_size=(24, 32)).create_envs(2, True)["tavis_head"][0]
+    niceness; its episodes are those of a new batch of that task (built in this process: same seeds, same pixels)."""
+    fresh = TavisEnvConfig(task="conditional_pick", image_size=(24, 32)).create_envs(2, False)["tavis_head"][0]
     expected, _ = fresh.reset(seed=[1000, 1001], options={NEW_ROLLOUT_OPTION: True})
     fresh.close()
     vec = TavisEnvConfig(task="wait_then_act", image_size=(24, 32), worker_niceness=3,

@@ -47,10 +47,11 @@ def test_one_env_gets_a_batch_dimension_and_bad_images_are_refused():
 
 KEEP_AND_EXIT = """
 import multiprocessing, sys
-from lerobot_tavis.eval.env_config import TavisEnvConfig
-from lerobot_tavis.eval import lerobot_run
 
-def keep_a_batch():
+def keep_a_batch():  # the job imports what it needs; the parent only starts it
+    from lerobot_tavis.eval.env_config import TavisEnvConfig
+    from lerobot_tavis.eval import lerobot_run
+
     batch = TavisEnvConfig(task="conditional_pick", image_size=(24, 32)).create_envs(2, True)["tavis_head"][0]
     batch.reset(seed=0)
     lerobot_run._KEPT["kept"] = batch  # as a policy job leaves it between chunks

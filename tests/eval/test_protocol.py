@@ -20,11 +20,14 @@ from lerobot_tavis.eval.run_identity import run_identity
 
 pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
+SHORT_S = 2.0  # seconds per demonstrator episode where a test compares runs, not outcomes
+
 
 def test_expert_protocol_writes_cells_and_report_resumes_and_ignores_workers_and_chunking(tmp_path, capsys):
     """A cell and its report, kept by a second run; then the cell played again over 2 workers in chunks of one seed
     (finishing in any order) is the cell one process wrote."""
-    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2)
+    common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2,
+                  episode_length_s=SHORT_S)
     one = tmp_path / "one"
     cfg = ProtocolConfig(out_dir=one, workers=1, **common)
     written = {p.name for p in run_protocol(cfg)}
@@ -51,7 +54,7 @@ def test_expert_protocol_writes_cells_and_report_resumes_and_ignores_workers_and
 
 def test_tasks_play_only_those_tasks_and_a_cell_of_other_tasks_is_not_reused(tmp_path):
     cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", splits=("id",), tasks=("occluded_reach",),
-                         n_episodes=2)
+                         n_episodes=2, episode_length_s=SHORT_S)
     assert cfg.suites == ("tavis_hands",)  # the task's suite
     run_protocol(cfg)
     assert [path.name for path in tmp_path.glob("*__*")] == ["tavis_hands__id"]
@@ -62,7 +65,7 @@ def test_tasks_play_only_those_tasks_and_a_cell_of_other_tasks_is_not_reused(tmp
     assert [(r["task"], r["seed"]) for r in records] == [("occluded_reach", 1000), ("occluded_reach", 1001)]
     with pytest.raises(InputError, match="holds the tasks \\['occluded_reach'\\], not those asked for"):
         run_protocol(ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",),
-                                    splits=("id",), n_episodes=2))
+                                    splits=("id",), n_episodes=2, episode_length_s=SHORT_S))
 
 
 def test_a_task_outside_the_suites_is_refused(tmp_path):
@@ -77,7 +80,7 @@ def _cell_files(root, cell="tavis_hands__id"):
 def test_finished_chunks_of_a_killed_run_are_kept(tmp_path):
     """A chunk whose `done` record exists is not played again: its stored outcome is what the cell reports."""
     cfg = ProtocolConfig(out_dir=tmp_path, expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",),
-                         n_episodes=1, chunk_episodes=1)
+                         n_episodes=1, chunk_episodes=1, episode_length_s=SHORT_S)
     work = tmp_path / ".tavis_hands__id.chunks"
     work.mkdir(parents=True)
     (work / "run.json").write_text(json.dumps(run_identity(cfg)))  # what the killed run wrote when it began
@@ -205,23 +208,22 @@ def test_lerobot_options_pass_through_to_the_policy_and_the_env(tmp_path, monkey
 
 
 @pytest.mark.parametrize("workers", [1, 2])
-def test_an_unknown_policy_option_names_the_field(tmp_path, workers):
-    """Refused by the first job to read the checkpoint's config, in this process or in a worker."""
-    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
-    cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("id",), n_episodes=1,
-                         image_size=(32, 48), policy_path=str(tmp_path / "ckpt"), policy_options=(("denoise", 3),),
+def test_an_unknown_policy_option_names_the_field(tmp_path, diffusion_checkpoint, workers):
+    """Refused by the first job to read the checkpoint's config, in this process or in a worker (one job: one
+    worker process loads LeRobot)."""
+    cfg = ProtocolConfig(out_dir=tmp_path / "eval", tasks=("conditional_pick",), splits=("id",), n_episodes=1,
+                         image_size=(32, 48), policy_path=str(diffusion_checkpoint), policy_options=(("denoise", 3),),
                          workers=workers)
     with pytest.raises(ValueError, match="--policy-option denoise: the diffusion policy has no such field"):
         run_protocol(cfg)
     assert not any((tmp_path / "eval").iterdir())
 
 
-def test_a_fresh_tavis_eval_process_reads_the_checkpoints_policy_type(tmp_path):
+def test_a_fresh_tavis_eval_process_reads_the_checkpoints_policy_type(tmp_path, diffusion_checkpoint):
     """In a new process nothing has imported LeRobot's policies yet: their types must be registered before the
     checkpoint's config is read (else: "Policy type 'diffusion' ... is not registered")."""
-    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
     tavis = os.path.join(os.path.dirname(sys.executable), "tavis")
-    done = subprocess.run([tavis, "eval", "--policy", str(tmp_path / "ckpt"), "--out", str(tmp_path / "eval"),
+    done = subprocess.run([tavis, "eval", "--policy", str(diffusion_checkpoint), "--out", str(tmp_path / "eval"),
                            "--policy-option", "denoise=3"], capture_output=True, text=True,
                           env={**os.environ, "HF_HUB_OFFLINE": "1"})
     assert done.returncode != 0
@@ -235,63 +237,74 @@ def test_a_missing_checkpoint_path_says_so(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-def _diffusion_checkpoint(path, image_size):
+@pytest.fixture(scope="module")
+def diffusion_checkpoint(tmp_path_factory):
+    """A tiny diffusion policy (random weights) saved as a checkpoint that reads 32x48 head images; tests only
+    read it."""
     from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
     from lerobot.policies.factory import make_policy, make_pre_post_processors
 
     from lerobot_tavis.eval.env_config import TavisEnvConfig
 
+    path = tmp_path_factory.mktemp("diffusion") / "ckpt"
     config = DiffusionConfig(pretrained_backbone_weights=None, device="cpu", push_to_hub=False,
                              down_dims=(16, 32, 64), horizon=16, n_action_steps=8, num_inference_steps=2)
-    policy = make_policy(config, env_cfg=TavisEnvConfig(image_size=image_size))
+    policy = make_policy(config, env_cfg=TavisEnvConfig(image_size=(32, 48)))
     policy.save_pretrained(path)
     for processor in make_pre_post_processors(config, dataset_stats=None):
         processor.save_pretrained(path)
+    return path
 
 
-def test_policy_protocol_runs_through_lerobot_eval_under_one_progress_bar(tmp_path, capsys):
-    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
-    cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), splits=("ood_init_pose",),
-                         n_episodes=1, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
-                         policy_options=(("num_inference_steps", 1),))
+def test_policy_protocol_runs_through_lerobot_eval_under_one_progress_bar(tmp_path, diffusion_checkpoint, capsys):
+    tasks = ("conditional_pick", "wait_then_act")
+    cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_head",), tasks=tasks,
+                         splits=("ood_init_pose",), n_episodes=1, image_size=(32, 48), episode_length_s=0.5,
+                         policy_path=str(diffusion_checkpoint), policy_options=(("num_inference_steps", 1),))
     capsys.readouterr()
     run_protocol(cfg)
     results = json.loads((tmp_path / "eval" / "results.json").read_text())
     assert [(c["task"], c["split"], c["n"]) for c in results["cells"]] == [
-        (task, "ood_init_pose", 1) for task in suite_tasks("tavis_head")]
+        (task, "ood_init_pose", 1) for task in tasks]
     bars = {line.split(":")[0] for line in re.split(r"[\r\n]+", capsys.readouterr().err) if "|" in line}
     assert bars == {"policy"}  # the run's own bar; none of lerobot-eval's batch and rollout bars
 
 
-def _tiny_policy_cell(tmp_path, name: str, suite: str, **settings):
-    """The id cell of `suite` (2 episodes per task) played by a tiny diffusion checkpoint made once per test."""
-    if not (tmp_path / "ckpt").exists():
-        _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
-    run_protocol(ProtocolConfig(out_dir=tmp_path / name, suites=(suite,), splits=("id",), n_episodes=2,
-                                image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
+def _tiny_policy_cell(checkpoint, out, suite: str, tasks: tuple[str, ...], **settings):
+    """The id cell of `suite` (2 episodes of each of `tasks`) played by the tiny diffusion `checkpoint`."""
+    run_protocol(ProtocolConfig(out_dir=out, suites=(suite,), tasks=tasks, splits=("id",), n_episodes=2,
+                                image_size=(32, 48), episode_length_s=0.5, policy_path=str(checkpoint),
                                 policy_options=(("num_inference_steps", 1),), **settings))
-    return _cell_files(tmp_path / name, f"{suite}__id")
+    return _cell_files(out, f"{suite}__id")
 
 
-def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first_videos(tmp_path):
-    """Each chunk is one lerobot-eval run seeded with its first seed: two workers give the cell of one."""
-    one = _tiny_policy_cell(tmp_path, "one", "tavis_head", workers=1, chunk_episodes=1)
-    assert one == _tiny_policy_cell(tmp_path, "two", "tavis_head", workers=2, chunk_episodes=1)
+def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first_videos(tmp_path,
+                                                                                        diffusion_checkpoint):
+    """Each chunk is one lerobot-eval run seeded with its first seed: two workers give the cell of one. One task's
+    two chunks (the cell's order over tasks, whatever the finishing order: the demonstrators' test above)."""
+    tasks = ("conditional_pick",)
+    one = _tiny_policy_cell(diffusion_checkpoint, tmp_path / "one", "tavis_head", tasks, workers=1, chunk_episodes=1)
+    assert one == _tiny_policy_cell(diffusion_checkpoint, tmp_path / "two", "tavis_head", tasks, workers=2,
+                                    chunk_episodes=1)
     records = [json.loads(line) for line in one[0].splitlines()]
-    assert [(r["task_id"], r["seed"]) for r in records] == [(t, s) for t in range(5) for s in (1000, 1001)]
+    assert [(r["task_id"], r["seed"]) for r in records] == [(0, 1000), (0, 1001)]
     videos = one[1]["per_task"][0]["metrics"]["video_paths"]
     assert videos == ["videos/tavis_head_0/eval_episode_0.mp4"]  # from the chunk of seed 1000 only
     assert (tmp_path / "one" / "tavis_head__id" / videos[0]).stat().st_size > 0
 
 
-def test_filming_changes_no_result_and_zero_films_nothing(tmp_path):
-    films = _tiny_policy_cell(tmp_path, "films", "tavis_hands", batch_size=2, film_episodes=2)
-    none = _tiny_policy_cell(tmp_path, "none", "tavis_hands", batch_size=2, film_episodes=0)
+def test_filming_changes_no_result_and_zero_films_nothing(tmp_path, diffusion_checkpoint):
+    """One task's batch of two async envs, both filmed or neither (each task's first chunk is filmed alike)."""
+    tasks = ("peeking_box",)
+    films = _tiny_policy_cell(diffusion_checkpoint, tmp_path / "films", "tavis_hands", tasks, batch_size=2,
+                              film_episodes=2)
+    none = _tiny_policy_cell(diffusion_checkpoint, tmp_path / "none", "tavis_hands", tasks, batch_size=2,
+                             film_episodes=0)
     assert films[0] == none[0]  # the episode logs
     assert [t["metrics"]["successes"] for t in films[1]["per_task"]] == [
         t["metrics"]["successes"] for t in none[1]["per_task"]]
-    assert [len(t["metrics"]["video_paths"]) for t in films[1]["per_task"]] == [2, 2, 2]
-    assert [t["metrics"]["video_paths"] for t in none[1]["per_task"]] == [[], [], []]
+    assert [len(t["metrics"]["video_paths"]) for t in films[1]["per_task"]] == [2]
+    assert [t["metrics"]["video_paths"] for t in none[1]["per_task"]] == [[]]
     assert not (tmp_path / "none" / "tavis_hands__id" / "videos").exists()
 
 
@@ -316,16 +329,15 @@ def _policy_run(checkpoint, out, task, keep_workers):
     return records, [info[key] for key in ("successes", "sum_rewards", "max_rewards")]
 
 
-def test_kept_env_workers_play_the_next_task_as_new_ones_would(tmp_path):
+def test_kept_env_workers_play_the_next_task_as_new_ones_would(tmp_path, diffusion_checkpoint):
     """A job's env workers outlive its run and build the next run's task in the same processes: same results."""
     from lerobot_tavis.eval import lerobot_run
 
-    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
     try:
-        _policy_run(tmp_path / "ckpt", tmp_path / "first", "wait_then_act", keep_workers=True)
+        _policy_run(diffusion_checkpoint, tmp_path / "first", "wait_then_act", keep_workers=True)
         (batch,) = lerobot_run._KEPT.values()
         workers = [process.pid for process in batch._started().processes]
-        kept = _policy_run(tmp_path / "ckpt", tmp_path / "kept", "conditional_pick", keep_workers=True)
+        kept = _policy_run(diffusion_checkpoint, tmp_path / "kept", "conditional_pick", keep_workers=True)
         assert list(lerobot_run._KEPT.values()) == [batch]
         assert [process.pid for process in batch._started().processes] == workers
         assert batch.call("task") == ("conditional_pick", "conditional_pick")
@@ -333,7 +345,7 @@ def test_kept_env_workers_play_the_next_task_as_new_ones_would(tmp_path):
     finally:
         lerobot_run.close_kept_envs()
     assert not lerobot_run._KEPT
-    fresh = _policy_run(tmp_path / "ckpt", tmp_path / "fresh", "conditional_pick", keep_workers=False)
+    fresh = _policy_run(diffusion_checkpoint, tmp_path / "fresh", "conditional_pick", keep_workers=False)
     assert not lerobot_run._KEPT
     assert kept == fresh
     assert [(json.loads(line)["task"], json.loads(line)["seed"]) for line in kept[0]] == [
@@ -345,41 +357,45 @@ def test_a_negative_film_count_is_refused(tmp_path):
         ProtocolConfig(out_dir=tmp_path, expert=True, film_episodes=-1)
 
 
-@pytest.mark.parametrize("envs, videos", [(["--eval.use_async_envs=false"], 2),
-                                          (["--eval.use_async_envs=true", "--env.filmed_envs=1"], 1)])
-def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path, envs, videos):
+def test_lerobot_eval_cli_writes_eval_info_and_the_episode_log(tmp_path):
+    """The console script, async envs of which one is filmed (sync envs: the checkpoint's test below)."""
     command = [os.path.join(os.path.dirname(sys.executable), "lerobot-eval"), "--env.type=tavis",
                "--env.task=wait_then_act", "--env.image_size=[32, 48]", "--env.episode_length_s=0.5",
                "--policy.type=diffusion", "--policy.pretrained_backbone_weights=null", "--policy.device=cpu",
                "--policy.down_dims=[16, 32, 64]", "--policy.num_inference_steps=2", "--eval.n_episodes=2",
-               "--eval.batch_size=2", *envs, f"--output_dir={tmp_path / 'out'}"]
+               "--eval.batch_size=2", "--eval.use_async_envs=true", "--env.filmed_envs=1",
+               f"--output_dir={tmp_path / 'out'}"]
     subprocess.run(command, check=True, capture_output=True, text=True, env={**os.environ, "HF_HUB_OFFLINE": "1"})
-    info = json.loads((tmp_path / "out" / "eval_info.json").read_text())
+    _assert_two_episodes_of_wait_then_act(tmp_path / "out", videos=1, steps=10)
+
+
+def _assert_two_episodes_of_wait_then_act(out, videos: int, steps: int):
+    """What lerobot-eval wrote in `out` for 2 episodes (seeds 1000, 1001) of wait_then_act, task 1 of tavis_head."""
+    info = json.loads((out / "eval_info.json").read_text())
     assert (info["per_task"][0]["task_group"], info["per_task"][0]["task_id"]) == ("tavis_head", 1)  # its index
     assert len(info["overall"]["video_paths"]) == videos
     assert all("/videos/tavis_head_1/" in path for path in info["overall"]["video_paths"])
-    records = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
+    records = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
     assert sorted(r["seed"] for r in records) == [1000, 1001]
-    assert all("galt_s" in r and r["length_steps"] == 10 and r["task_id"] == 1 for r in records)
+    assert all("galt_s" in r and r["length_steps"] == steps and r["task_id"] == 1 for r in records)
 
 
-def test_lerobot_eval_of_a_checkpoint_renders_the_size_it_was_trained_at(tmp_path, monkeypatch, caplog):
+def test_lerobot_eval_of_a_checkpoint_renders_the_size_it_was_trained_at(tmp_path, diffusion_checkpoint,
+                                                                        monkeypatch, caplog):
     """The issue's case: `lerobot-eval --policy.path=<checkpoint> --env.type=tavis` without `--env.image_size`
     renders the checkpoint's size (32x48 here), not the env's default 480x640 (LeRobot's eval_main, in this
-    process)."""
+    process); sync envs film every episode."""
     from lerobot.scripts import lerobot_eval
 
-    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
     monkeypatch.setattr("sys.argv", [
-        "lerobot-eval", "--env.type=tavis", "--env.task=conditional_pick", "--env.episode_length_s=0.2",
-        f"--policy.path={tmp_path / 'ckpt'}", "--policy.device=cpu", "--eval.n_episodes=1", "--eval.batch_size=1",
+        "lerobot-eval", "--env.type=tavis", "--env.task=wait_then_act", "--env.episode_length_s=0.2",
+        f"--policy.path={diffusion_checkpoint}", "--policy.device=cpu", "--eval.n_episodes=2", "--eval.batch_size=2",
         "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'out'}"])
     monkeypatch.setenv("HF_HUB_OFFLINE", "1")
     with caplog.at_level(logging.INFO, logger="lerobot_tavis.eval.env_config"):
         lerobot_eval.eval_main()
     assert "the env takes the checkpoint's image_size 32x48" in caplog.text
-    (record,) = [json.loads(line) for line in (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()]
-    assert record["length_steps"] == 4
+    _assert_two_episodes_of_wait_then_act(tmp_path / "out", videos=2, steps=4)
 
 
 def test_the_eval_config_of_a_checkpoint_does_not_warn_of_random_weights(caplog):
@@ -401,12 +417,13 @@ def test_the_eval_config_of_a_checkpoint_does_not_warn_of_random_weights(caplog)
         pipeline_config(env=TavisEnvConfig(), policy=DiffusionConfig(), job_name="probe")
 
 
-def test_a_policy_run_annotates_its_videos_while_it_plays(tmp_path):
-    """Each filmed chunk's videos are annotated as it finishes, so the cell holds its copies before any report."""
-    _diffusion_checkpoint(tmp_path / "ckpt", (32, 48))
+def test_a_policy_run_annotates_its_videos_while_it_plays(tmp_path, diffusion_checkpoint):
+    """Each filmed chunk's videos are annotated as it finishes (by the annotator's processes while the next chunk
+    plays), so the cell holds its copies before any report."""
     cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_hands",), tasks=("peeking_box",), splits=("id",),
-                         n_episodes=2, image_size=(32, 48), episode_length_s=0.5, policy_path=str(tmp_path / "ckpt"),
-                         policy_options=(("num_inference_steps", 1),), workers=2, chunk_episodes=1, film_episodes=1)
+                         n_episodes=2, image_size=(32, 48), episode_length_s=0.5,
+                         policy_path=str(diffusion_checkpoint), policy_options=(("num_inference_steps", 1),),
+                         chunk_episodes=1, film_episodes=1)
     run_cells(cfg, [Cell("tavis_hands", "id")], run_identity(cfg))
     cell = tmp_path / "eval" / "tavis_hands__id"
     video = cell / "videos" / "tavis_hands_0" / "eval_episode_0.mp4"

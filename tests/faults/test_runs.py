@@ -30,6 +30,12 @@ def _command(*args) -> list[str]:
     return [sys.executable, "-m", "lerobot_tavis.cli", *map(str, args)]
 
 
+def _argv(*args) -> list[str]:
+    """`tavis` arguments for `main` in this process (the `refused` fixture): where a test reads a refusal's line,
+    not the process."""
+    return list(map(str, args))
+
+
 def _tavis(*args) -> subprocess.CompletedProcess:
     return subprocess.run(_command(*args), capture_output=True, text=True, env={**os.environ, "MUJOCO_GL": "egl"},
                           timeout=600)
@@ -67,7 +73,7 @@ def finished_eval(tmp_path_factory):
     return out
 
 
-def test_a_killed_eval_resumed_with_other_settings_is_refused_and_the_same_settings_resume(tmp_path):
+def test_a_killed_eval_resumed_with_other_settings_is_refused_and_the_same_settings_resume(tmp_path, refused):
     out = tmp_path / "eval"
     first = _start(*EVAL, "--expert", "--episodes", "20", "--chunk-episodes", "1", "--out", out)
     try:
@@ -83,7 +89,7 @@ def test_a_killed_eval_resumed_with_other_settings_is_refused_and_the_same_setti
                          (["--expert", "--camera-mode", "fixed_wrist"], "--camera-mode head_wrist, not --camera-mode "
                                                                         "fixed_wrist"),
                          (["--policy", checkpoint], f"--expert, not --policy {checkpoint}")):
-        line = _error_line(_tavis(*EVAL, *other, "--episodes", "20", "--chunk-episodes", "1", "--out", out))
+        line = refused(_argv(*EVAL, *other, "--episodes", "20", "--chunk-episodes", "1", "--out", out))
         assert line == (f"tavis eval: error: {out}/.{CELL}.chunks was played with {shown}: pass --restart to play it "
                         "again with these settings, or give another --out")
     done = _tavis(*EVAL, "--expert", "--episodes", "20", "--chunk-episodes", "1", "--out", out)
@@ -96,18 +102,19 @@ def test_a_killed_eval_resumed_with_other_settings_is_refused_and_the_same_setti
     assert all(r["run"] == info["run"] for r in records)
 
 
-def test_a_finished_eval_rerun_with_other_settings_is_refused_and_restart_plays_it_again(finished_eval, tmp_path):
+def test_a_finished_eval_rerun_with_other_settings_is_refused_and_restart_plays_it_again(finished_eval, tmp_path,
+                                                                                          refused):
     out = shutil.copytree(finished_eval, tmp_path / "eval")
     for other, shown in ((["--episodes", "2"], "--episodes 1, not --episodes 2"),
                          (["--seed", "7"], "--seed 1000, not --seed 7"),
                          (["--robot", "reachy2"], "--robot gr1t2, not --robot reachy2"),
                          (["--camera-mode", "fixed_wrist"], "--camera-mode head_wrist, not --camera-mode fixed_wrist"),
                          (["--episode-length-s", "2"], "--episode-length-s 1, not --episode-length-s 2")):
-        line = _error_line(_tavis(*EVAL, "--expert", "--episodes", "1", *other, "--out", out))
+        line = refused(_argv(*EVAL, "--expert", "--episodes", "1", *other, "--out", out))
         assert line == (f"tavis eval: error: {out}/{CELL} was played with {shown}: pass --restart to play it again "
                         "with these settings, or give another --out")
-    line = _error_line(_tavis(*EVAL, "--expert", "--episodes", "1", "--robot", "reachy2", "--splits", "ood_spatial",
-                              "--out", out))  # another cell into an output of another run's cells
+    line = refused(_argv(*EVAL, "--expert", "--episodes", "1", "--robot", "reachy2", "--splits", "ood_spatial",
+                         "--out", out))  # another cell into an output of another run's cells
     assert line == (f"tavis eval: error: {out} holds {CELL}, which was played with --robot gr1t2, not --robot "
                     "reachy2: one output directory holds the cells of one run; give another --out")
     same = _tavis(*EVAL, "--expert", "--episodes", "1", "--out", out)
@@ -123,7 +130,7 @@ def _rewrite_records(cell, change) -> None:
     log.write_text("".join(json.dumps(change(json.loads(line))) + "\n" for line in log.read_text().splitlines()))
 
 
-def test_report_refuses_a_cell_whose_records_come_from_different_runs(finished_eval, tmp_path):
+def test_report_refuses_a_cell_whose_records_come_from_different_runs(finished_eval, tmp_path, refused):
     out = shutil.copytree(finished_eval, tmp_path / "eval")
     (record,) = _records(out)
     other = {**record, "seed": 1001, "run": {**record["run"], "policy": "/elsewhere/pretrained_model",
@@ -133,7 +140,7 @@ def test_report_refuses_a_cell_whose_records_come_from_different_runs(finished_e
     info = json.loads((out / CELL / "eval_info.json").read_text())
     info["per_task"][0]["metrics"]["successes"].append(False)
     (out / CELL / "eval_info.json").write_text(json.dumps(info))
-    line = _error_line(_tavis("report", out))
+    line = refused(_argv("report", out))
     assert line == (f'tavis report: error: peeking_box id: its episodes disagree on run.policy ("scripted '
                     f'demonstrators" and "/elsewhere/pretrained_model", in {out}/{CELL}): they come from different runs')
 
@@ -199,14 +206,14 @@ def _files(folder) -> dict:
 
 
 @pytest.mark.parametrize("where", ["same", "above", "inside", "link", "from_tavis"])
-def test_convert_refuses_a_root_that_is_holds_or_lies_in_its_input(raw_copy, tmp_path, where):
+def test_convert_refuses_a_root_that_is_holds_or_lies_in_its_input(raw_copy, tmp_path, refused, where):
     before = _files(raw_copy)
     if where == "link":
         (tmp_path / "link").symlink_to(raw_copy)
     root = {"same": raw_copy, "above": tmp_path, "inside": raw_copy / "dataset", "link": tmp_path / "link",
             "from_tavis": raw_copy}[where]
     source = ["--from-tavis", raw_copy] if where == "from_tavis" else [raw_copy]
-    line = _error_line(_tavis("convert", *source, "--repo-id", "local/x", "--root", root, "--overwrite"))
+    line = refused(_argv("convert", *source, "--repo-id", "local/x", "--root", root, "--overwrite"))
     relation = {"above": "holds", "inside": "is inside"}.get(where, "is")
     assert line == (f"tavis convert: error: --root {root} {relation} the input {raw_copy}: a conversion never writes "
                     "where it reads; give a destination outside it")
