@@ -28,6 +28,7 @@ FPS = 10  # the module's main dataset: every 6th tick a frame (half the frames o
 STRIDE = 60 // FPS
 SMALL = (24, 32)  # the other conversions (rendering costs the same per frame at any size this small)
 TWO_CAMERAS = ("head", "left_wrist")
+DATASET_CAMERAS = ("head", "fixed")  # of the main dataset; the wrist cameras are converted in `peeking_box`
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +44,7 @@ def dataset(raw_dir, tmp_path_factory):
 
     root = tmp_path_factory.mktemp("converted") / "hands"
     main(["convert", str(raw_dir), "--repo-id", "local/tavis-hands-gr1t2", "--root", str(root), "--fps", str(FPS),
-          "--image-size", "48x64", "--cameras", "head,fixed,left_wrist,right_wrist"])
+          "--image-size", "48x64", "--cameras", ",".join(DATASET_CAMERAS)])
     return LeRobotDataset("local/tavis-hands-gr1t2", root=root, video_backend="pyav")
 
 
@@ -125,9 +126,10 @@ def test_converted_dataset_features_names_and_counts(dataset, raw_dir):
     manifest = raw_files.Manifest.load(raw_dir)
     assert dataset.fps == FPS and dataset.num_episodes == len(manifest.episodes) == 6
     features = dataset.meta.features
-    for camera in ("head", "fixed", "left_wrist", "right_wrist"):
+    for camera in DATASET_CAMERAS:
         assert features[image_key(camera)]["dtype"] == "video"
         assert tuple(features[image_key(camera)]["shape"]) == (*IMAGE_SIZE, 3)
+    assert image_key("left_wrist") not in features and image_key("right_wrist") not in features  # not asked for
     assert features[STATE_KEY]["names"] == list(canonical.ACTION_NAMES)
     assert features[ACTION_KEY]["names"] == list(canonical.ACTION_NAMES)
     assert features[JOINT_POS_KEY]["names"] == list(make_robot("gr1t2").joint_names())
