@@ -102,7 +102,7 @@ def test_demonstrator_completes_its_task_and_evaluate_decides_as_before(tiny_env
 
 @pytest.mark.parametrize("task", ["conditional_pick", "clutter_pick_lift"])
 def test_gaze_arrives_before_the_grasp(tiny_env, task):
-    env = tiny_env(task, robot="reachy2")
+    env = tiny_env(task, robot="reachy2", cameras=())  # the lead is read from the actions: nothing to render
     leads = [compute_galt(r.actions, fps=20).galt_s for r in (run_episode(env, seed) for seed in range(3))
              if r.success]
     assert leads and all(lead is not None and 0.3 <= lead <= 2.0 for lead in leads), leads
@@ -131,7 +131,7 @@ def test_peek_falls_back_to_a_reachable_wrist_pose(tiny_env):
 
 
 def test_same_seed_same_demonstration(tiny_env):
-    env = tiny_env("wait_then_act")
+    env = tiny_env("wait_then_act", cameras=())  # the demonstrator reads the simulator's state, not pixels
     first, second = run_episode(env, 4), run_episode(env, 4)
     np.testing.assert_array_equal(first.actions, second.actions)
     other = run_episode(env, 5)

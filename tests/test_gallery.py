@@ -3,35 +3,49 @@ import pytest
 
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, VISUAL_FACTORS
 from lerobot_tavis.gallery import (OOD_VISUAL_VIEWS, SHEET_VIEWS, GalleryConfig, Stills, capture_stills,
-                                   ood_visual_sheet, overview_figure, write_gallery)
+                                   overview_figure, task_sheet, write_gallery)
 
 pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
 
-def test_task_sheet_shows_the_first_observation_and_the_grasp(tmp_path):
-    written = write_gallery(GalleryConfig(tmp_path, robots=("gr1t2",), tasks=("conditional_pick",),
-                                          image_size=(48, 64)))
-    assert [p.relative_to(tmp_path).as_posix() for p in written] == ["gallery/gr1t2/conditional_pick.png",
-                                                                     "gallery/gr1t2/ood_visual.png"]
-    assert not (tmp_path / "overview.png").exists()  # the figure needs all eight tasks
-    assert not list(tmp_path.rglob("*.partial*"))
+SIZE = (48, 64)
 
 
-def test_stills_change_between_first_observation_and_grasp():
-    stills = capture_stills("conditional_pick", "gr1t2", image_size=(48, 64))
+@pytest.fixture(scope="module")
+def gallery(tmp_path_factory):
+    """`tavis gallery` of conditional_pick on GR1T2 at SIZE: (its output directory, the files it wrote)."""
+    out = tmp_path_factory.mktemp("gallery")
+    return out, write_gallery(GalleryConfig(out, robots=("gr1t2",), tasks=("conditional_pick",), image_size=SIZE))
+
+
+@pytest.fixture(scope="module")
+def stills():
+    """The gallery's stills of conditional_pick on GR1T2 (seed 0), captured again in this process."""
+    return capture_stills("conditional_pick", "gr1t2", image_size=SIZE)
+
+
+def _read_png(path) -> np.ndarray:
+    import cv2
+
+    return cv2.cvtColor(cv2.imread(str(path)), cv2.COLOR_BGR2RGB)
+
+
+def test_task_sheet_shows_the_first_observation_and_the_grasp_the_same_every_time(gallery, stills):
+    out, written = gallery
+    assert [p.relative_to(out).as_posix() for p in written] == ["gallery/gr1t2/conditional_pick.png",
+                                                                "gallery/gr1t2/ood_visual.png"]
+    assert not (out / "overview.png").exists()  # the figure needs all eight tasks
+    assert not list(out.rglob("*.partial*"))
+    np.testing.assert_array_equal(_read_png(written[0]), task_sheet(stills))  # the same seed, the same pixels
+
+
+def test_stills_change_between_first_observation_and_grasp(stills):
     assert stills.grasped
     assert set(stills.first) == set(stills.grasp) == set(SHEET_VIEWS)
     for view in SHEET_VIEWS:
-        assert stills.first[view].shape == (48, 64, 3)
+        assert stills.first[view].shape == (*SIZE, 3)
     moved = [view for view in SHEET_VIEWS if np.abs(stills.first[view].astype(int) - stills.grasp[view]).mean() > 2]
     assert "overview" in moved and "head" in moved
-
-
-def test_stills_are_deterministic():
-    a = capture_stills("peeking_box", "reachy2", image_size=(32, 48), seed=3)
-    b = capture_stills("peeking_box", "reachy2", image_size=(32, 48), seed=3)
-    for view in SHEET_VIEWS:
-        np.testing.assert_array_equal(a.grasp[view], b.grasp[view])
 
 
 def test_overview_figure_holds_every_task_and_both_robots():
@@ -48,9 +62,10 @@ def test_overview_figure_holds_every_task_and_both_robots():
     assert figure.shape[1] > 5 * 80 and figure.shape[0] > 4 * 60
 
 
-def test_the_ood_visual_sheet_has_a_row_per_look_and_only_the_looks_differ():
-    sheet = ood_visual_sheet("conditional_pick", "gr1t2", image_size=(48, 64), seed=2)
-    rows = sheet.reshape(len(VISUAL_FACTORS) + 2, 48, len(OOD_VISUAL_VIEWS) * 64, 3)
+def test_the_ood_visual_sheet_has_a_row_per_look_and_only_the_looks_differ(gallery):
+    out, _ = gallery
+    sheet = _read_png(out / "gallery" / "gr1t2" / "ood_visual.png")  # OOD_VISUAL_TASK, conditional_pick
+    rows = sheet.reshape(len(VISUAL_FACTORS) + 2, SIZE[0], len(OOD_VISUAL_VIEWS) * SIZE[1], 3)
     below_labels = rows[:, 12:]
     for row in below_labels[1:]:
         assert np.abs(row.astype(int) - below_labels[0]).mean() > 0.5  # every look differs from id

@@ -51,7 +51,7 @@ def _cell(root: Path, name: str = "tavis_hands__id") -> tuple[str, dict]:
 
 def test_demonstrator_protocol_on_ray_equals_local(tmp_path, ray_cluster):
     common = dict(expert=True, robot="gr1t2", suites=("tavis_hands",), splits=("id",), n_episodes=2,
-                  chunk_episodes=1)
+                  chunk_episodes=1, episode_length_s=2.0)  # each episode's first seconds: the same or not
     run_protocol(ProtocolConfig(out_dir=tmp_path / "local", workers=1, **common))
     run_protocol(ProtocolConfig(out_dir=tmp_path / "ray", workers=2, backend="ray", **common))
     assert _cell(tmp_path / "ray") == _cell(tmp_path / "local")

@@ -22,7 +22,7 @@ pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 TINY = (48, 64)
 CAMERAS = ("head", "left_wrist", "right_wrist")
 CAMERA_KEYS = [f"observation.images.{camera}" for camera in CAMERAS]
-FPS = 20
+FPS = 10  # the dataset's rate: 10 Hz has half the frames of the default 20 Hz to convert and compare
 # Two past frames and a chunk of actions: windows that run over both ends of an episode (padding flags, clamped rows).
 DELTA_TIMESTAMPS = {**{key: [-2 / FPS, -1 / FPS, 0.0] for key in [*CAMERA_KEYS, "observation.state"]},
                     "action": [step / FPS for step in range(6)]}
@@ -30,10 +30,10 @@ DELTA_TIMESTAMPS = {**{key: [-2 / FPS, -1 / FPS, 0.0] for key in [*CAMERA_KEYS, 
 
 @pytest.fixture(scope="module")
 def dataset_root(conditional_pick_raw, tmp_path_factory):
-    """The run's two conditional_pick demonstrations at 48x64 with the head and wrist cameras (AV1), and their frame
-    cache."""
+    """The run's two conditional_pick demonstrations at 48x64 and FPS with the head and wrist cameras (AV1), and their
+    frame cache."""
     root = convert(ConvertConfig(conditional_pick_raw, "local/tiny", tmp_path_factory.mktemp("frame_cache") / "dataset",
-                                 image_size=TINY, cameras=CAMERAS), progress=False)
+                                 fps=FPS, image_size=TINY, cameras=CAMERAS), progress=False)
     main(["cache-frames", str(root)])
     return root
 

@@ -24,6 +24,11 @@ pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
 HANDS = suite_tasks("tavis_hands")
 IMAGE_SIZE = (48, 64)
+FPS = 10  # the module's main dataset: every 6th tick a frame (half the frames of the default 20 Hz to render)
+STRIDE = 60 // FPS
+SMALL = (24, 32)  # the other conversions (rendering costs the same per frame at any size this small)
+TWO_CAMERAS = ("head", "left_wrist")
+DATASET_CAMERAS = ("head", "fixed")  # of the main dataset; the wrist cameras are converted in `peeking_box`
 
 
 @pytest.fixture(scope="module")
@@ -38,9 +43,41 @@ def dataset(raw_dir, tmp_path_factory):
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     root = tmp_path_factory.mktemp("converted") / "hands"
-    main(["convert", str(raw_dir), "--repo-id", "local/tavis-hands-gr1t2", "--root", str(root), "--fps", "20",
-          "--image-size", "48x64", "--cameras", "head,fixed,left_wrist,right_wrist"])
+    main(["convert", str(raw_dir), "--repo-id", "local/tavis-hands-gr1t2", "--root", str(root), "--fps", str(FPS),
+          "--image-size", "48x64", "--cameras", ",".join(DATASET_CAMERAS)])
     return LeRobotDataset("local/tavis-hands-gr1t2", root=root, video_backend="pyav")
+
+
+@pytest.fixture(scope="module")
+def peeking_box(raw_dir, tmp_path_factory):
+    """peeking_box's two episodes, head and left wrist cameras, converted by one worker while LeRobot's video encoder
+    starts late, as on a loaded machine: each episode's frames all queue up before it encodes one."""
+    import time
+
+    from lerobot.datasets import video_utils
+
+    encode = video_utils._CameraEncoderThread.run
+
+    def lagging(thread):
+        time.sleep(3.0)
+        encode(thread)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(video_utils._CameraEncoderThread, "run", lagging)
+        return convert(ConvertConfig(raw_dir, "local/peeking_box", tmp_path_factory.mktemp("lagged") / "peeking_box",
+                                     image_size=SMALL, task="peeking_box", cameras=TWO_CAMERAS), progress=False)
+
+
+@pytest.fixture(scope="module")
+def occluded_reach(raw_dir, tmp_path_factory):
+    """occluded_reach's two episodes converted by the `tavis` console script as a user runs it, with the cameras
+    and size of `peeking_box`: (the dataset's root, everything the process printed)."""
+    root = tmp_path_factory.mktemp("console") / "occluded_reach"
+    tavis = os.path.join(os.path.dirname(sys.executable), "tavis")
+    done = subprocess.run([tavis, "convert", str(raw_dir), "--repo-id", "local/occluded_reach", "--root", str(root),
+                           "--image-size", "x".join(map(str, SMALL)), "--cameras", ",".join(TWO_CAMERAS),
+                           "--task", "occluded_reach"], capture_output=True, text=True, timeout=300, check=True)
+    return root, done.stdout + done.stderr
 
 
 def _copy_raw(raw_dir, tmp_path):
@@ -87,17 +124,18 @@ def test_record_refuses_a_directory_of_another_robot(raw_dir):
 
 def test_converted_dataset_features_names_and_counts(dataset, raw_dir):
     manifest = raw_files.Manifest.load(raw_dir)
-    assert dataset.fps == 20 and dataset.num_episodes == len(manifest.episodes) == 6
+    assert dataset.fps == FPS and dataset.num_episodes == len(manifest.episodes) == 6
     features = dataset.meta.features
-    for camera in ("head", "fixed", "left_wrist", "right_wrist"):
+    for camera in DATASET_CAMERAS:
         assert features[image_key(camera)]["dtype"] == "video"
         assert tuple(features[image_key(camera)]["shape"]) == (*IMAGE_SIZE, 3)
+    assert image_key("left_wrist") not in features and image_key("right_wrist") not in features  # not asked for
     assert features[STATE_KEY]["names"] == list(canonical.ACTION_NAMES)
     assert features[ACTION_KEY]["names"] == list(canonical.ACTION_NAMES)
     assert features[JOINT_POS_KEY]["names"] == list(make_robot("gr1t2").joint_names())
     lengths = {row["episode_index"]: row["length"] for row in dataset.meta.episodes}
     episodes = _episodes_in_dataset_order(manifest)
-    assert [lengths[i] for i in range(6)] == [-(-e.n_steps // 3) for e in episodes]  # ceil(T / 3)
+    assert [lengths[i] for i in range(6)] == [-(-e.n_steps // STRIDE) for e in episodes]  # ceil(T / STRIDE)
 
 
 def _episodes_in_dataset_order(manifest):
@@ -109,72 +147,56 @@ def test_frames_pair_each_observation_with_the_last_command_of_its_interval(data
     start = 0
     for index, entry in enumerate(episodes):
         episode = raw_files.load_episode(raw_dir / entry.file)
-        n_frames = -(-entry.n_steps // 3)
+        n_frames = -(-entry.n_steps // STRIDE)
         for j in (0, 7, n_frames - 1):
             frame = dataset[start + j]
             assert int(frame["episode_index"]) == index and int(frame["frame_index"]) == j
-            last_tick = min(3 * j + 3, entry.n_steps) - 1  # frame j observes tick 3j; ticks 3j..3j+2 follow it
+            last_tick = min(STRIDE * (j + 1), entry.n_steps) - 1  # frame j observes tick STRIDE * j, the rest follow
             np.testing.assert_array_equal(frame[ACTION_KEY].numpy(), episode.actions[last_tick].astype(np.float32))
             assert frame["task"] == episode.prompt and frame["task_name"] == entry.task and frame["split"] == "id"
         start += n_frames
     first = dataset[0]
     assert first[image_key("head")].shape == (3, *IMAGE_SIZE)
     blocked = HANDS.index("blocked_clutter_pick_cube") * 2
-    blocked_start = sum(-(-e.n_steps // 3) for e in episodes[:blocked])
+    blocked_start = sum(-(-e.n_steps // STRIDE) for e in episodes[:blocked])
     assert float(dataset[blocked_start][image_key("head")].max()) < 0.05  # the head camera is black there
     log = json.loads((dataset.root / "meta" / "tavis_conversion.json").read_text())
     assert [e["max_qpos_deviation"] for e in log["episodes"]] == [0.0] * 6  # exact replay
     assert log["shadows"] is True  # rendered as evaluation renders by default
 
 
-def test_convert_prints_its_progress_and_no_encoder_chatter(raw_dir, tmp_path):
+def test_convert_prints_its_progress_and_no_encoder_chatter(occluded_reach):
     """No SVT-AV1 banner, FFmpeg muxer line, per-episode `datasets` bar or traceback: only tavis's own output."""
-    tavis = os.path.join(os.path.dirname(sys.executable), "tavis")
-    done = subprocess.run([tavis, "convert", str(raw_dir), "--repo-id", "local/quiet", "--root", str(tmp_path / "ds"),
-                           "--image-size", "24x32", "--cameras", "head", "--task", "occluded_reach"],
-                          capture_output=True, text=True, timeout=300, check=True)
-    output = done.stdout + done.stderr
+    root, output = occluded_reach
     for chatter in ("Svt[", "[mp4 @", "Map:", "Traceback", "moov atom"):
         assert chatter not in output, f"{chatter!r} in:\n{output}"
-    assert "convert local/quiet" in output and str(tmp_path / "ds") in output
+    assert "convert local/occluded_reach" in output and str(root) in output
 
 
-def test_converting_twice_gives_identical_data_whatever_the_workers(raw_dir, tmp_path):
+def test_converting_twice_gives_identical_data_whatever_the_workers(raw_dir, peeking_box, tmp_path):
+    """Two workers and an encoder on time against `peeking_box` (one worker, its encoder late)."""
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    roots = []
-    for name, workers in (("a", 1), ("b", 2)):
-        cfg = ConvertConfig(raw_dir, f"local/{name}", tmp_path / name, image_size=IMAGE_SIZE, task="peeking_box",
-                            cameras=("head", "left_wrist"), workers=workers)
-        roots.append(convert(cfg, progress=False))
-    tables = [pd.read_parquet(root / "data") for root in roots]
-    pd.testing.assert_frame_equal(*tables)
-    first, second = (LeRobotDataset(f"local/{n}", root=r, video_backend="pyav") for n, r in zip("ab", roots))
+    again = convert(ConvertConfig(raw_dir, "local/again", tmp_path / "again", image_size=SMALL, task="peeking_box",
+                                  cameras=TWO_CAMERAS, workers=2), progress=False)
+    pd.testing.assert_frame_equal(*(pd.read_parquet(root / "data") for root in (peeking_box, again)))
+    first = LeRobotDataset("local/peeking_box", root=peeking_box, video_backend="pyav")
+    second = LeRobotDataset("local/again", root=again, video_backend="pyav")
     for index in (0, len(first) - 1):
-        for camera in ("head", "left_wrist"):
+        for camera in TWO_CAMERAS:
             assert np.array_equal(first[index][image_key(camera)].numpy(), second[index][image_key(camera)].numpy())
 
 
-def test_no_frame_is_lost_when_the_video_encoder_lags(raw_dir, tmp_path, monkeypatch):
+def test_no_frame_is_lost_when_the_video_encoder_lags(peeking_box):
     """LeRobot's streaming encoder drops frames that find its queue full; conversion must not lose any."""
-    import time
-
-    from lerobot.datasets import video_utils
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    encode = video_utils._CameraEncoderThread.run
-
-    def lagging(thread):  # an encoder that starts late, as on a loaded machine: the whole episode queues up
-        time.sleep(3.0)
-        encode(thread)
-
-    monkeypatch.setattr(video_utils._CameraEncoderThread, "run", lagging)
-    root = convert(ConvertConfig(raw_dir, "local/lag", tmp_path / "lag", image_size=IMAGE_SIZE, task="peeking_box",
-                                 cameras=("head",)), progress=False)
-    dataset = LeRobotDataset("local/lag", root=root, video_backend="pyav")
+    dataset = LeRobotDataset("local/peeking_box", root=peeking_box, video_backend="pyav")
     assert dataset.num_frames > 60  # more than LeRobot's default queue of 30 frames per episode
-    for index in range(len(dataset)):  # every frame decodes at its own timestamp
-        assert dataset[index][image_key("head")].shape == (3, *IMAGE_SIZE)
+    for index in range(len(dataset)):  # every frame of every camera decodes at its own timestamp
+        frame = dataset[index]
+        for camera in TWO_CAMERAS:
+            assert frame[image_key(camera)].shape == (3, *SMALL)
 
 
 def test_a_replay_that_ends_differently_is_an_error(raw_dir, tmp_path):
@@ -199,11 +221,10 @@ def test_an_existing_destination_needs_overwrite(raw_dir, tmp_path):
         convert(cfg, progress=False)
 
 
-def test_lerobot_merges_converted_datasets(raw_dir, tmp_path):
+def test_lerobot_merges_converted_datasets(peeking_box, occluded_reach, tmp_path):
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    roots = [convert(ConvertConfig(raw_dir, f"local/{task}", tmp_path / task, image_size=IMAGE_SIZE, task=task,
-                                   cameras=("head",)), progress=False) for task in ("peeking_box", "occluded_reach")]
+    roots = [peeking_box, occluded_reach[0]]
     merged = tmp_path / "merged"
     command = [sys.executable, "-m", "lerobot.scripts.lerobot_edit_dataset", "--new_repo_id", "local/merged",
                "--new_root", str(merged), "--operation.type", "merge",
@@ -221,12 +242,13 @@ def test_other_frame_storages_hold_the_same_frames(raw_dir, dataset, tmp_path, s
 
     root = tmp_path / storage
     main(["convert", str(raw_dir), "--repo-id", f"local/{storage}", "--root", str(root), "--image-size", "48x64",
-          "--cameras", "fixed", "--task", "peeking_box", "--storage", storage])
+          "--fps", str(FPS), "--cameras", "fixed", "--task", "peeking_box", "--storage", storage])
     other = LeRobotDataset(f"local/{storage}", root=root, video_backend="pyav")
     key = image_key("fixed")
     assert other.meta.features[key]["dtype"] == ("image" if storage == "png" else "video")
     assert json.loads((root / "meta" / "tavis_conversion.json").read_text())["storage"] == storage
-    reference = [i for i in range(len(dataset)) if dataset[i]["task_name"] == "peeking_box"]
+    task_names = pd.read_parquet(dataset.root / "data", columns=["task_name"])["task_name"]
+    reference = [i for i, name in enumerate(task_names) if name == "peeking_box"]
     assert len(other) == len(reference)
     for i in (0, len(other) // 2, len(other) - 1):
         frame, expected = other[i], dataset[reference[i]]

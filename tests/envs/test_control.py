@@ -41,7 +41,7 @@ def _settle(controller, model, data, action, seconds):
 
 
 def test_rest_action_settles_each_hand_within_1cm_and_3deg(small_env, robot_name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixed_only")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixed_only", cameras=())
     rest = canonical.rest_action()
     perturbed = rest.copy()
     perturbed[0:3] += (0.05, 0.05, -0.05)
@@ -84,7 +84,7 @@ def test_reach_grid_is_tracked_within_1cm_wherever_reachable(robot_name):
 
 
 def test_head_pitch_and_yaw_are_tracked_within_002_rad(small_env, robot_name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="head_only")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="head_only", cameras=())
     env.reset(seed=0)
     limits = env.world.robot.neck_range_rad()
     for pitch_frac, yaw_frac in [(0.8, 0.0), (-0.5, 0.6), (0.3, -0.9), (0.0, 0.2)]:
@@ -96,7 +96,7 @@ def test_head_pitch_and_yaw_are_tracked_within_002_rad(small_env, robot_name):
 
 
 def test_head_and_gripper_commands_are_clipped_to_their_ranges(small_env, robot_name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="head_only")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="head_only", cameras=())
     env.reset(seed=0)
     action = canonical.rest_action()
     action[canonical.HEAD] = (5.0, -5.0, 5.0)
@@ -112,7 +112,7 @@ def test_head_and_gripper_commands_are_clipped_to_their_ranges(small_env, robot_
 
 
 def test_unreachable_target_gives_the_closest_pose_never_nan(small_env, robot_name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixed_only")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixed_only", cameras=())
     env.reset(seed=0)
     action = canonical.rest_action()
     action[canonical.LEFT.position] = (3.0, 2.0, 1.5)  # 3.7 m away
@@ -127,7 +127,7 @@ def test_unreachable_target_gives_the_closest_pose_never_nan(small_env, robot_na
 
 
 def test_bad_actions_raise_naming_the_problem(small_env):
-    env = small_env(task="tabletop", robot="gr1t2", camera_mode="fixed_only")
+    env = small_env(task="tabletop", robot="gr1t2", camera_mode="fixed_only", cameras=())
     env.reset(seed=0)
     with pytest.raises(ValueError, match=r"shape \(19,\)"):
         env.step(np.zeros(18))

@@ -15,7 +15,7 @@ LIFT_M = 0.20
 
 @pytest.mark.parametrize("name", OBJECT_NAMES)
 def test_grasp_and_lift(small_env, robot_name, name):
-    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixed_only")
+    env = small_env(task="tabletop", robot=robot_name, camera_mode="fixed_only", cameras=())  # nothing to render
     env.reset(seed=0)
     model, data, ik = env.model, env.data, env.controller.ik
     side = "left" if OBJECT_NAMES.index(name) % 2 == 0 else "right"

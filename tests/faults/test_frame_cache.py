@@ -86,7 +86,7 @@ def test_cache_frames_refuses_what_it_cannot_cache_in_one_line_and_writes_nothin
 
 
 def test_cache_frames_refuses_a_dataset_without_videos(conditional_pick_raw, tmp_path):
-    root = convert(ConvertConfig(conditional_pick_raw, "local/png", tmp_path / "dataset", image_size=(48, 64),
+    root = convert(ConvertConfig(conditional_pick_raw, "local/png", tmp_path / "dataset", fps=10, image_size=(24, 32),
                                  cameras=("head",), storage="png", task="conditional_pick"), progress=False)
     with pytest.raises(SystemExit) as refusal:
         main(["cache-frames", str(root)])
