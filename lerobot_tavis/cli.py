@@ -20,7 +20,7 @@ from lerobot_tavis.cli_options import CommandParser, from_args, option, spelling
 from lerobot_tavis.errors import FieldError, InputError, PathNotFoundError, TavisError, surroundings_message
 from lerobot_tavis.tempdir import use_private_tempdir
 
-INTERRUPT_GRACE_S = 3.0  # how long a broken worker pool waits for the Ctrl-C that may have broken it
+INTERRUPT_GRACE_S = 1.0  # how long a broken worker pool waits for the Ctrl-C that may have broken it
 
 
 @dataclass(frozen=True)
@@ -395,8 +395,6 @@ def main(argv: list[str] | None = None) -> None:
         try:
             time.sleep(INTERRUPT_GRACE_S)
         except KeyboardInterrupt:
-            _interrupted(command)
-        if signal.SIGINT in signal.sigpending():  # arrived, but held back in this thread
             _interrupted(command)
         raise
 

@@ -38,8 +38,10 @@ def leave_interrupt_to_parent() -> None:
     """In a worker: Ctrl-C ends this process at once and quietly, instead of raising KeyboardInterrupt, which
     printed a traceback per worker. The terminal sends SIGINT to every process of its group; the main process,
     which alone writes files, reports it once and unwinds, removing its staging copies. A worker started with
-    SIGINT blocked (`workers`, so that a Ctrl-C while it starts up waits) receives it from here on."""
-    signal.signal(signal.SIGINT, _exit_quietly)
+    SIGINT blocked (`workers`, so that a Ctrl-C while it starts up waits) receives it from here on. A worker whose
+    parent ignores SIGINT (a job a script started in the background) ignores it too, as the parent does."""
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:  # inherited through exec, as the parent's is
+        signal.signal(signal.SIGINT, _exit_quietly)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 

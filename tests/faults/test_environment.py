@@ -201,12 +201,31 @@ def test_temporary_files_of_workers_and_libraries_go_with_the_run(tmp_path, tmpd
     assert list(tmpdir_.iterdir()) == []
 
 
+@pytest.mark.parametrize("inherited", ["default", "ignored"])
+def test_a_worker_ends_on_ctrl_c_unless_its_parent_ignores_it(inherited):
+    """A job a script started in the background ignores Ctrl-C, and so do its workers, instead of dying under it."""
+    start = "signal.signal(signal.SIGINT, signal.SIG_IGN)\n" if inherited == "ignored" else ""
+    script = ("import signal\n" + start + "from lerobot_tavis.process import leave_interrupt_to_parent\n"
+              "leave_interrupt_to_parent()\nsignal.raise_signal(signal.SIGINT)\nprint('still here')\n")
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    if inherited == "ignored":
+        assert (result.returncode, result.stdout) == (0, "still here\n")
+    else:
+        assert (result.returncode, result.stdout, result.stderr) == (128 + signal.SIGINT, "", "")
+
+
 def test_ctrl_c_is_one_line_and_removes_the_staging_copy(raw_copy, tmp_path, tmpdir_):
     root = tmp_path / "dataset"
     command = [sys.executable, "-m", "lerobot_tavis.cli", "convert", str(raw_copy), "--repo-id", "local/x",
                "--root", str(root), "--image-size", "48x64", "--workers", "2"]
-    process = subprocess.Popen(command, env={**os.environ, "MUJOCO_GL": "egl", "TMPDIR": str(tmpdir_)},
-                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    # The command starts as a terminal's foreground job does, with Ctrl-C at its default, whatever this test process
+    # inherited (a Python handler becomes the default across exec; an ignored signal would stay ignored).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        process = subprocess.Popen(command, env={**os.environ, "MUJOCO_GL": "egl", "TMPDIR": str(tmpdir_)},
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     deadline = time.monotonic() + 180
     while not list(tmp_path.glob(".dataset.partial-*")):
         assert process.poll() is None and time.monotonic() < deadline, "the conversion never started staging"
