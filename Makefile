@@ -1,6 +1,7 @@
 # Two entry points for a fresh machine: `make demo` and `make test`. Both create .venv with Python 3.12 when
 # missing and install the package (editable, with its extras) into it, with uv: the same packages from PyPI as pip
-# would install, downloaded and unpacked in parallel.
+# would install, downloaded and unpacked in parallel, and compiled to bytecode at once as pip does (else every first
+# import of torch or LeRobot compiles it).
 
 VENV := .venv
 STAMP := $(VENV)/.installed
@@ -34,7 +35,7 @@ ifeq ($(CPU),1)
 		|| { echo "CPU=1: PyTorch's CPU wheels could not be installed from $(TORCH_CPU_INDEX) (PyPI has none" \
 			"for Linux); without CPU=1, PyPI's CUDA build runs on a CPU as well"; exit 1; }
 endif
-	$(VENV)/bin/python -m uv pip install --python $(VENV)/bin/python -e '.[dev]'
+	$(VENV)/bin/python -m uv pip install --compile-bytecode --python $(VENV)/bin/python -e '.[dev]'
 	touch $(STAMP)
 
 # Headless OpenGL for MuJoCo (EGL on Mesa); Xvfb, the virtual display the viewer's test (and `xvfb-run -a
