@@ -204,8 +204,10 @@ def test_temporary_files_of_workers_and_libraries_go_with_the_run(tmp_path, tmpd
 @pytest.mark.parametrize("inherited", ["default", "ignored"])
 def test_a_worker_ends_on_ctrl_c_unless_its_parent_ignores_it(inherited):
     """A job a script started in the background ignores Ctrl-C, and so do its workers, instead of dying under it."""
-    start = "signal.signal(signal.SIGINT, signal.SIG_IGN)\n" if inherited == "ignored" else ""
-    script = ("import signal\n" + start + "from lerobot_tavis.process import leave_interrupt_to_parent\n"
+    start = "SIG_IGN" if inherited == "ignored" else "SIG_DFL"  # what the worker found at its start, set explicitly:
+    # this test's own process may have inherited SIGINT ignored
+    script = (f"import signal\nsignal.signal(signal.SIGINT, signal.{start})\n"
+              "from lerobot_tavis.process import leave_interrupt_to_parent\n"
               "leave_interrupt_to_parent()\nsignal.raise_signal(signal.SIGINT)\nprint('still here')\n")
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
     if inherited == "ignored":
