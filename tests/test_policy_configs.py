@@ -46,8 +46,8 @@ def test_the_shipped_files_are_the_generated_presets():
     assert len(preset_names()) == 14
     for name, (policy, mode, compact) in presets().items():
         assert json.loads(preset_path(name).read_text()) == build_preset(policy, mode, compact), name
-    with pytest.raises(ValueError, match="unknown preset"):
-        preset_path("act_headcam")
+    with pytest.raises(ValueError, match="unknown preset"), pytest.warns(FutureWarning, match="now called 'head_only'"):
+        preset_path("act_headcam")  # the old name of head_only, which has no ACT preset
     with pytest.raises(ValueError, match="compact presets exist for"):
         build_preset("act", "head_only", compact=True)
     with pytest.raises(ValueError, match="compact presets are of act, act_hand_relative, diffusion_hand_relative"):
