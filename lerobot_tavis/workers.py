@@ -109,10 +109,10 @@ def executor(workers: int, backend: str = "local", gpus_per_job: float = 0.0, ni
     if workers == 1:
         return InlineExecutor()
     context = _SpawnContext()
-    started = context.Value("i", 0)  # workers started so far: each takes the next share of the CPUs
-    cpus = sorted(os.sched_getaffinity(0)) if share_cpus else None
+    # (workers started so far, each taking the next share; the CPUs shared out)
+    sharing = (context.Value("i", 0), sorted(os.sched_getaffinity(0))) if share_cpus else None
     return ProcessPoolExecutor(workers, mp_context=context, initializer=_start_local_worker,
-                               initargs=(os.getpid(), niceness, started, workers, cpus))
+                               initargs=(os.getpid(), niceness, workers, sharing))
 
 
 def cpu_share(index: int, workers: int, cpus: list[int]) -> set[int]:
@@ -135,13 +135,14 @@ class _SpawnContext(multiprocessing.context.SpawnContext):
     Process = _SpawnedWorker
 
 
-def _start_local_worker(parent_pid: int, niceness: int, started, workers: int, cpus: list[int] | None) -> None:
+def _start_local_worker(parent_pid: int, niceness: int, workers: int, sharing: tuple | None) -> None:
     die_with_parent(parent_pid)
     leave_interrupt_to_parent()
     if niceness:
         os.nice(niceness)
-    if cpus is None:
+    if sharing is None:
         return
+    started, cpus = sharing
     with started.get_lock():
         index = started.value
         started.value += 1

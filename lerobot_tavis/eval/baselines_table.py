@@ -159,7 +159,7 @@ def with_table(readme: str, body: str, path: Path) -> str:
     _, end, tail = rest.partition(README_END + "\n")
     if not begin or not end:
         raise InputError(f"{path}: no table markers: put the line '{README_BEGIN}' and, below it, the line "
-                             f"'{README_END}' where the table goes")
+                         f"'{README_END}' where the table goes")
     return f"{head}{begin}{body}{end}{tail}"
 
 
