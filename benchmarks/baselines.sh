@@ -16,9 +16,10 @@
 # A finished condition becomes RESULTS/<robot>/<task>/<condition>/: the `tavis eval` output without videos, the
 # training config (train_config.json), the run's log (log.txt, each progress bar's last state), the model card
 # (model_card.md) and recipe.json (the recipe, the commit, the machine, the command). That folder is moved into
-# place whole, then its entry is added to BASELINES (`tavis table-add`). A condition whose folder exists is skipped; one whose folder records another recipe
-# stops the command with a message naming it: one table, one recipe. On the machine of an interrupted run, a
-# training that reached its last step is evaluated again (`tavis eval` resuming its finished chunks), not retrained.
+# place whole, then its entry is added to BASELINES (`tavis table-add`). A condition whose folder exists is
+# skipped; one whose folder records another recipe stops the command with a message naming it: one table, one
+# recipe. On the machine of an interrupted run, a training that reached its last step is evaluated again (`tavis
+# eval` resuming its finished chunks), not retrained.
 # WORK/<robot>_<task>/ keeps the recording, datasets, checkpoints, logs and the upload-ready model folders
 # (model_<condition>/: checkpoint, card, results; `huggingface-cli upload <repo id> <folder>`).
 #
