@@ -2,12 +2,16 @@
 and timestamp by timestamp, without decoding a video; a cache of an earlier state of the dataset is refused; and
 lerobot-train trains from it, data-parallel under `accelerate launch` (on CPU here: two processes, gloo)."""
 
+import contextlib
 import json
 import os
 import pickle
 import shutil
+import signal
+import socket
 import subprocess
 import sys
+import time
 
 import pytest
 import torch
@@ -36,6 +40,36 @@ def dataset_root(conditional_pick_raw, tmp_path_factory):
                                  fps=FPS, image_size=TINY, cameras=CAMERAS), progress=False)
     main(["cache-frames", str(root)])
     return root
+
+
+def _free_port() -> int:
+    """A TCP port of the loopback interface that was free a moment ago."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def _run_with_stacks_on_timeout(command: list[str], env: dict, timeout_s: float) -> tuple[int, str]:
+    """Runs `command`; returns its exit status and its output (stdout and stderr). Past `timeout_s` every process it
+    started (torchrun's ranks run in sessions of their own) prints its Python stacks (faulthandler, SIGABRT) and is
+    killed, and the test fails showing them: a hang names the line it hangs on."""
+    import psutil
+
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                               env={**env, "PYTHONFAULTHANDLER": "1"})
+    try:
+        output = process.communicate(timeout=timeout_s)[0]
+        return process.returncode, output
+    except subprocess.TimeoutExpired:
+        tree = [process.pid, *(child.pid for child in psutil.Process(process.pid).children(recursive=True))]
+        for signal_number in (signal.SIGABRT, signal.SIGKILL):
+            for pid in tree:
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(pid, signal_number)
+            time.sleep(5)
+        output = process.communicate()[0]
+        pytest.fail(f"{' '.join(command[:6])} ... did not end in {timeout_s} s; its processes' stacks:\n"
+                    f"{output[-12000:]}")
 
 
 def _assert_same_sample(got: dict, want: dict, index: int) -> None:
@@ -160,17 +194,18 @@ def test_lerobot_train_reads_the_cache_data_parallel_under_accelerate(dataset_ro
     for feature in preset["policy"]["input_features"].values():
         feature["shape"] = [3, *TINY]
     (tmp_path / "preset.json").write_text(json.dumps(preset))
-    env = {**os.environ, "MUJOCO_GL": "egl", "TAVIS_FRAME_CACHE": "1"}
+    # The ranks meet on the loopback interface at a port no other run on the machine holds (29500 by default).
+    env = {**os.environ, "MUJOCO_GL": "egl", "TAVIS_FRAME_CACHE": "1", "GLOO_SOCKET_IFNAME": "lo"}
     train = [sys.executable, "-m", "accelerate.commands.launch", "--multi_gpu", "--num_processes", "2",
              "--num_machines", "1", "--mixed_precision", "no", "--dynamo_backend", "no",
+             "--main_process_ip", "127.0.0.1", "--main_process_port", str(_free_port()),
              "-m", "lerobot.scripts.lerobot_train", f"--config_path={tmp_path / 'preset.json'}",
              "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", "--env.task=conditional_pick",
              "--policy.device=cpu", "--policy.dim_model=32", "--policy.dim_feedforward=64", "--policy.n_heads=2",
              "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", "--log_freq=1",
              f"--output_dir={tmp_path / 'train'}"]
-    run = subprocess.run(train, capture_output=True, text=True, env=env, timeout=600)
-    log = run.stdout + run.stderr
-    assert run.returncode == 0, log[-3000:]
+    returncode, log = _run_with_stacks_on_timeout(train, env, timeout_s=300)
+    assert returncode == 0, log[-3000:]
     assert f"video frames from {cache_dir(dataset_root)}" in log
     assert "Effective batch size: 2 x 2 = 4" in log
     config = json.loads((tmp_path / "train" / "checkpoints" / "last" / "pretrained_model" / "config.json").read_text())
