@@ -1,5 +1,5 @@
-"""Worker processes never outlive the process that started them (kill -9 included) and leave Ctrl-C to it; whether
-a process is alive. No heavy imports."""
+"""Worker processes never outlive the process that started them (kill -9 included), leave Ctrl-C to it and need
+not import its main script; whether a process is alive. No heavy imports."""
 
 from __future__ import annotations
 
@@ -62,6 +62,25 @@ def interrupt_deferred() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, held)
         if arrived:
             signal.raise_signal(signal.SIGINT)
+
+
+@contextlib.contextmanager
+def children_skip_main_module() -> Iterator[None]:
+    """Processes started (spawn or forkserver) within the block do not import this process's main script or module
+    again. multiprocessing has each such child import the parent's `__main__`, so that objects pickled from it
+    resolve: under `lerobot-eval` that is LeRobot's eval script, and with it torch and LeRobot in every child. Only
+    for children whose pickled targets live in importable modules (the block hides `__main__`'s file and spec, as in
+    an interactive session, whose children import no main either)."""
+    main = sys.modules["__main__"]
+    saved = {name: main.__dict__[name] for name in ("__file__", "__spec__") if name in main.__dict__}
+    main.__dict__.pop("__file__", None)
+    main.__spec__ = None
+    try:
+        yield
+    finally:
+        main.__dict__.update(saved)
+        if "__spec__" not in saved:
+            del main.__spec__
 
 
 def alive(pid: int) -> bool:

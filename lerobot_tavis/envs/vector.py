@@ -29,6 +29,8 @@ from dataclasses import dataclass, field
 
 import gymnasium as gym
 
+from lerobot_tavis.process import children_skip_main_module
+
 NEW_ROLLOUT_OPTION = "lerobot_new_rollout"  # lerobot.envs.utils.NEW_ROLLOUT_OPTION (a test keeps them equal)
 
 
@@ -147,8 +149,9 @@ class LazyAsyncVectorEnv:
     def _started(self) -> gym.vector.AsyncVectorEnv:
         if self._env is None:
             workers = [WorkerEnv(self._frozen, index, self._worker_niceness) for index in range(self.num_envs)]
-            self._env = gym.vector.AsyncVectorEnv(workers, context="forkserver", shared_memory=True,
-                                                  autoreset_mode=gym.vector.AutoresetMode.NEXT_STEP)
+            with children_skip_main_module():  # under lerobot-eval, its script would bring torch into every worker
+                self._env = gym.vector.AsyncVectorEnv(workers, context="forkserver", shared_memory=True,
+                                                      autoreset_mode=gym.vector.AutoresetMode.NEXT_STEP)
         elif self._retargeting:
             self._retargeting = False
             self._env.call_wait()

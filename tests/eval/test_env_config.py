@@ -2,6 +2,8 @@
 
 import json
 import os
+import sys
+import types
 import warnings
 from dataclasses import dataclass
 from functools import partial
@@ -91,7 +93,14 @@ def test_each_task_keeps_its_index_in_its_suite_whatever_else_runs():
     assert [factory.keywords["task_id"] for factory in whole.values()] == list(whole)
 
 
-def test_async_create_envs_run_in_forkserver_workers():
+def test_async_create_envs_run_in_lean_forkserver_workers(tmp_path, monkeypatch):
+    """The workers import neither torch nor LeRobot, nor the main script of the process that starts them (under
+    lerobot-eval, LeRobot's: multiprocessing would have each worker import it, and torch with it)."""
+    script = tmp_path / "main_script.py"
+    script.write_text(f"import pathlib\npathlib.Path({str(tmp_path / 'imported')!r}).touch()\n")
+    main = types.ModuleType("__main__")
+    main.__file__, main.__spec__ = str(script), None
+    monkeypatch.setitem(sys.modules, "__main__", main)
     config = TavisEnvConfig(task="wait_then_act", image_size=(24, 32))
     vec = config.create_envs(n_envs=2, use_async_envs=True)["tavis_head"][1]
     assert isinstance(vec, LazyAsyncVectorEnv)
@@ -103,6 +112,8 @@ def test_async_create_envs_run_in_forkserver_workers():
     mapped = [Path(f"/proc/{pid}/maps").read_text() for pid in workers]
     vec.close()
     assert len(mapped) == 2 and not any("libtorch" in maps or "/lerobot/" in maps for maps in mapped)
+    assert not (tmp_path / "imported").exists()
+    assert main.__file__ == str(script) and main.__spec__ is None  # as it was
 
 
 def test_only_the_filmed_sub_envs_of_an_async_batch_draw_frames():
