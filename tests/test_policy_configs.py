@@ -155,21 +155,21 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
 @pytest.mark.parametrize(("name", "policy_type"), [("act_head_wrist_compact", "act"),
                                                   ("act_hand_relative_head_wrist_compact", "act_hand_relative")])
 def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, name,
-                                                                             policy_type):
+                                                                             policy_type, monkeypatch):
     """benchmarks/train_baseline.sh's STATE_INPUT=off: the compact preset's inputs less observation.state; the
-    hand-frame preset, whose policy type this package registers and lerobot-train finds through the plugin, with its
-    time input (a feature no dataset holds; the policy without it trains and acts in tests/policies)."""
+    hand-frame preset, whose policy type this package registers (a lerobot-train process of its own finds it through
+    the plugin in tests/dataset_tools/test_frame_cache.py), with its time input (a feature no dataset holds; the
+    policy without it trains and acts in tests/policies)."""
     preset = json.loads(preset_path(name).read_text())
     preset["policy"]["input_features"].pop("observation.state", None)
     for feature in preset["policy"]["input_features"].values():
         feature["shape"] = [3, *TINY]
     (tmp_path / "preset.json").write_text(json.dumps(preset))
-    env = {**os.environ, "MUJOCO_GL": "egl"}
-    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={tmp_path / 'preset.json'}",
-             "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", "--env.task=conditional_pick",
-             "--policy.device=cpu", "--policy.dim_model=32", "--policy.dim_feedforward=64", "--policy.n_heads=2",
-             "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}"]
-    subprocess.run(train, check=True, capture_output=True, env=env, timeout=600)
+    _lerobot_train_in_this_process(
+        monkeypatch, f"--config_path={tmp_path / 'preset.json'}", "--dataset.repo_id=local/tiny",
+        f"--dataset.root={dataset_root}", "--env.task=conditional_pick", "--policy.device=cpu",
+        "--policy.dim_model=32", "--policy.dim_feedforward=64", "--policy.n_heads=2", "--steps=2", "--save_freq=2",
+        "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}")
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
     assert config["type"] == policy_type and "observation.state" not in config["input_features"]
@@ -177,8 +177,8 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
     _one_short_episode(checkpoint, tmp_path / "eval")
 
 
-def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_root, tmp_path):
-    """`diffusion_hand_relative`, registered by this package and found by lerobot-train through the plugin, with its
+def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, monkeypatch):
+    """`diffusion_hand_relative`, registered by this package (found by lerobot-train as the hand-frame ACT is), with its
     time input (a feature no dataset holds): a few steps on the tiny dataset (its cameras at their size, one shared
     image encoder), then one short episode."""
     preset = json.loads(preset_path("diffusion_hand_relative_head_wrist_compact").read_text())
@@ -186,12 +186,10 @@ def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_roo
         if feature["type"] == "VISUAL":
             feature["shape"] = [3, *TINY]
     (tmp_path / "preset.json").write_text(json.dumps(preset))
-    env = {**os.environ, "MUJOCO_GL": "egl"}
-    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={tmp_path / 'preset.json'}",
-             "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", *SMALL_RUN,
-             "--policy.use_separate_rgb_encoder_per_camera=false", "--steps=2", "--save_freq=2", "--batch_size=2",
-             "--num_workers=0", f"--output_dir={tmp_path / 'train'}"]
-    subprocess.run(train, check=True, capture_output=True, env=env, timeout=600)
+    _lerobot_train_in_this_process(
+        monkeypatch, f"--config_path={tmp_path / 'preset.json'}", "--dataset.repo_id=local/tiny",
+        f"--dataset.root={dataset_root}", *SMALL_RUN, "--policy.use_separate_rgb_encoder_per_camera=false",
+        "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}")
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
     assert (config["type"], config["time_input"], config["state_input"]) == ("diffusion_hand_relative", True, "none")
@@ -249,6 +247,16 @@ def test_presets_command_lists_and_locates(capsys):
     assert capsys.readouterr().out.split() == preset_names()
     main(["presets", "pi0_fixed_wrist"])
     assert capsys.readouterr().out.strip() == str(preset_path("pi0_fixed_wrist"))
+
+
+def _lerobot_train_in_this_process(monkeypatch, *arguments: str) -> None:
+    """lerobot-train's console-script entry point with `arguments`, in this process (its own process, which finds
+    the plugin as LeRobot does, is the diffusion preset's test above)."""
+    from lerobot.scripts import lerobot_train
+
+    monkeypatch.setattr("sys.argv", ["lerobot-train", *arguments])
+    monkeypatch.setenv("MUJOCO_GL", "egl")
+    lerobot_train.main()
 
 
 def _one_short_episode(checkpoint, out) -> None:
