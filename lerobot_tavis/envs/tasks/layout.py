@@ -129,19 +129,22 @@ def _circle_hits_rectangle(centre, radius, rect_xy, rect_yaw, half_xy) -> np.nda
 
 
 def _rectangles_overlap(xy, yaw, half_xy, other_xy, other_yaw, other_half_xy, gap_m) -> np.ndarray:
-    """Separating-axis test of rectangles (xy (N, 2), yaw (N,)) against one rectangle, each grown by gap_m / 2."""
-    def axes(angle):
+    """Separating-axis test of rectangles (xy (N, 2), yaw (N,)) against one rectangle, each grown by gap_m / 2. The
+    dot products are written out per component (the layouts of every seed depend on these exact sums)."""
+    def axes(angle):  # the rectangles' two axes, each as its (x, y) components
         c, s = np.cos(angle), np.sin(angle)
-        return np.stack([np.column_stack([c, s]), np.column_stack([-s, c])])  # (2, N, 2)
+        return (c, s), (-s, c)
 
     mine = axes(np.asarray(yaw, dtype=float))
-    theirs = np.broadcast_to(axes(np.array([other_yaw])), mine.shape)
+    theirs = axes(np.array([other_yaw]))
     half = np.asarray(half_xy) + gap_m / 2
     other_half = np.asarray(other_half_xy) + gap_m / 2
     offset = np.asarray(other_xy) - xy
     separated = np.zeros(len(xy), dtype=bool)
-    for axis in (*mine, *theirs):  # each (N, 2)
-        reach = sum(h * np.abs(np.sum(axis * a, axis=1)) for h, a in zip(half, mine))
-        reach += sum(h * np.abs(np.sum(axis * a, axis=1)) for h, a in zip(other_half, theirs))
-        separated |= np.abs(np.sum(axis * offset, axis=1)) > reach
+    for ax, ay in (*mine, *theirs):
+        reach = (half[0] * np.abs(ax * mine[0][0] + ay * mine[0][1])
+                 + half[1] * np.abs(ax * mine[1][0] + ay * mine[1][1]))
+        reach += (other_half[0] * np.abs(ax * theirs[0][0] + ay * theirs[0][1])
+                  + other_half[1] * np.abs(ax * theirs[1][0] + ay * theirs[1][1]))
+        separated |= np.abs(ax * offset[:, 0] + ay * offset[:, 1]) > reach
     return ~separated
