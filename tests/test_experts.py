@@ -76,11 +76,12 @@ def _successes(env, seeds, enough: int, played=()) -> int:
 
 @pytest.mark.parametrize("task", TASKS)
 def test_demonstrator_completes_its_task_and_evaluate_decides_as_before(tiny_env, task, tmp_path):
-    """Seed 0 played with the episode log and the success rule as it was before `Task.evaluate` beside every step;
-    seeds 1 and 2 only while none has succeeded."""
+    """Seed 1 played with the episode log and the success rule as it was before `Task.evaluate` beside every step;
+    seeds 2 and 3 only while none has succeeded. (Not seed 0: wait_then_act's demonstrator plans its pick many times
+    over on it, 192 reach checks against seed 1's 12, about ten times the time.)"""
     log = tmp_path / "episodes.jsonl"
     env = _Steps(EpisodeLogger(tiny_env(task, cameras=()), log, "suite", 0))
-    result = run_episode(env, seed=0)
+    result = run_episode(env, seed=1)
     for old, info in env.steps:
         assert info["is_success"] == old
         flags = [value for value in info["conditions"].values() if isinstance(value, bool)]
@@ -96,7 +97,7 @@ def test_demonstrator_completes_its_task_and_evaluate_decides_as_before(tiny_env
         assert 0.0 <= reach[-1]["first_grasp_xy_m"] <= 0.02, reach[-1]  # pads centred on the object
         across_jaws = reach[-1]["first_grasp_in_hand_m"][1]  # the object's centre between the pads
         assert abs(across_jaws) <= 0.012 and np.linalg.norm(reach[-1]["first_grasp_in_hand_m"]) <= REACHED_M, reach[-1]
-    completed = _successes(tiny_env(task, cameras=()), (1, 2), enough=1, played=[result])
+    completed = _successes(tiny_env(task, cameras=()), (2, 3), enough=1, played=[result])
     assert completed >= 1, f"{task}: no success in 3 seeds"
 
 
