@@ -221,16 +221,18 @@ def test_an_existing_destination_needs_overwrite(raw_dir, tmp_path):
         convert(cfg, progress=False)
 
 
-def test_lerobot_merges_converted_datasets(peeking_box, occluded_reach, tmp_path):
+def test_lerobot_merges_converted_datasets(peeking_box, occluded_reach, tmp_path, monkeypatch):
+    """LeRobot's lerobot-edit-dataset (its entry point, in this process) merges two converted datasets."""
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
+    from lerobot.scripts import lerobot_edit_dataset
 
     roots = [peeking_box, occluded_reach[0]]
     merged = tmp_path / "merged"
-    command = [sys.executable, "-m", "lerobot.scripts.lerobot_edit_dataset", "--new_repo_id", "local/merged",
-               "--new_root", str(merged), "--operation.type", "merge",
-               "--operation.repo_ids", "['local/peeking_box', 'local/occluded_reach']",
-               "--operation.roots", str([str(r) for r in roots])]
-    subprocess.run(command, check=True, capture_output=True, timeout=300)
+    monkeypatch.setattr("sys.argv", [
+        "lerobot-edit-dataset", "--new_repo_id", "local/merged", "--new_root", str(merged), "--operation.type", "merge",
+        "--operation.repo_ids", "['local/peeking_box', 'local/occluded_reach']",
+        "--operation.roots", str([str(r) for r in roots])])
+    lerobot_edit_dataset.main()
     dataset = LeRobotDataset("local/merged", root=merged, video_backend="pyav")
     assert dataset.num_episodes == 4
     assert {dataset[0]["task_name"], dataset[len(dataset) - 1]["task_name"]} == {"peeking_box", "occluded_reach"}
