@@ -1,5 +1,6 @@
 """Worker processes never outlive the process that started them (kill -9 included), leave Ctrl-C to it and need
-not import its main script; whether a process is alive. No heavy imports."""
+not import its main script; threads that cannot make themselves real-time; whether a process is alive. No heavy
+imports."""
 
 from __future__ import annotations
 
@@ -13,7 +14,17 @@ import threading
 from collections.abc import Iterator
 
 _PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
+_CAP_SYS_NICE = 23  # from <linux/capability.h>: may raise a thread's scheduling priority (real-time included)
+_CAPABILITY_VERSION_3 = 0x20080522  # capget/capset's header version for 64 capability bits (two 32-bit words)
 MAX_NICENESS = 19  # Linux's lowest CPU priority; a process's niceness stops there
+
+
+class _CapabilityHeader(ctypes.Structure):
+    _fields_ = [("version", ctypes.c_uint32), ("pid", ctypes.c_int)]
+
+
+class _CapabilityWord(ctypes.Structure):
+    _fields_ = [("effective", ctypes.c_uint32), ("permitted", ctypes.c_uint32), ("inheritable", ctypes.c_uint32)]
 
 
 def die_with_parent(parent_pid: int) -> None:
@@ -81,6 +92,42 @@ def children_skip_main_module() -> Iterator[None]:
         main.__dict__.update(saved)
         if "__spec__" not in saved:
             del main.__spec__
+
+
+@contextlib.contextmanager
+def without_realtime_priority() -> Iterator[None]:
+    """Within the block, this thread and the threads it starts cannot switch themselves to real-time scheduling.
+
+    SVT-AV1 (LeRobot's AV1 encoder, through PyAV) moves the thread that opens an encoder to SCHED_FIFO at priority
+    99 wherever the process may (root, as in containers and on cloud machines), and with it every thread the encoder
+    then starts: encoding preempts everything else on those cores, rendering workers included, and a process that
+    such a thread starts inherits the policy. The block takes the capability that allows it (CAP_SYS_NICE) out of
+    this thread's effective set, which the threads it starts inherit, and gives it back at the end. Lowering a
+    priority (`nice`) needs no capability. Where the capability is not held (not root, most containers), or off
+    Linux, nothing changes."""
+    held = sys.platform.startswith("linux") and _set_effective_capability(_CAP_SYS_NICE, False)
+    try:
+        yield
+    finally:
+        if held:
+            _set_effective_capability(_CAP_SYS_NICE, True)
+
+
+def _set_effective_capability(capability: int, effective: bool) -> bool:
+    """Put `capability` in or out of this thread's effective set (out always works; in, if it is permitted);
+    returns whether it was effective before."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    header = _CapabilityHeader(_CAPABILITY_VERSION_3, 0)  # pid 0: the calling thread
+    words = (_CapabilityWord * 2)()
+    if libc.capget(ctypes.byref(header), words) != 0:
+        raise OSError(ctypes.get_errno(), "capget failed")
+    word, bit = divmod(capability, 32)
+    was_effective = bool(words[word].effective & (1 << bit))
+    if was_effective != effective:
+        words[word].effective ^= 1 << bit
+        if libc.capset(ctypes.byref(header), words) != 0:
+            raise OSError(ctypes.get_errno(), "capset failed")
+    return was_effective
 
 
 def alive(pid: int) -> bool:

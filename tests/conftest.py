@@ -10,8 +10,18 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from lerobot_tavis.envs.robots import BUILTIN_ROBOTS  # noqa: E402
+from lerobot_tavis.process import without_realtime_priority  # noqa: E402
 
 ROBOTS = BUILTIN_ROBOTS
+
+
+@pytest.fixture(scope="session", autouse=True)
+def normal_priority():
+    """The test processes stay at normal scheduling whatever their tests encode: the fixtures that write datasets
+    through LeRobot's own API encode AV1 in the test process, and SVT-AV1 would otherwise leave it real-time (as
+    root), and with it every process it starts afterwards (`process.without_realtime_priority`)."""
+    with without_realtime_priority():
+        yield
 
 
 def pytest_collection_modifyitems(items):

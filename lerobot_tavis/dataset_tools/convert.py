@@ -34,6 +34,7 @@ from lerobot_tavis.dataset_tools.raw import Manifest, RawEpisode, RawEpisodeErro
 from lerobot_tavis.envs.tasks.catalog import task_sort_key
 from lerobot_tavis.errors import FieldError, InputError, TavisError
 from lerobot_tavis.locking import exclusive_output
+from lerobot_tavis.process import without_realtime_priority
 from lerobot_tavis.staging import staged_directory
 from lerobot_tavis.workers import executor
 
@@ -96,8 +97,9 @@ def _check_root_apart(root: Path, source: Path) -> None:
 
 def convert(cfg: ConvertConfig, progress: bool = True) -> Path:
     """Convert `cfg.raw_dir` (or `cfg.from_tavis`) into a LeRobotDataset at `cfg.root`; returns the root. One
-    conversion at a time per root (`locking`): another one converting into it is refused, naming it."""
-    with exclusive_output(cfg.root):
+    conversion at a time per root (`locking`): another one converting into it is refused, naming it. The video
+    encoders run at normal priority (`process.without_realtime_priority`), also where the process is root."""
+    with exclusive_output(cfg.root), without_realtime_priority():
         return _convert(cfg, progress)
 
 
