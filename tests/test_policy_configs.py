@@ -127,17 +127,16 @@ def test_zero_neck_conversion_for_the_fixed_camera_presets(conditional_pick_demo
 
 def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_eval(dataset_root, tmp_path,
                                                                                      monkeypatch):
-    """lerobot-train's own process (the plugin found as LeRobot finds it), then lerobot-eval's eval_main in this
-    process (tests/eval/test_protocol.py runs lerobot-eval's console script)."""
+    """lerobot-train with its periodic evaluation in the env, then lerobot-eval of the checkpoint, both through their
+    entry points in this process (lerobot-train's own processes, which find the plugin as LeRobot does, are in
+    tests/dataset_tools/test_frame_cache.py; lerobot-eval's console script in tests/eval/test_protocol.py)."""
     from lerobot.scripts import lerobot_eval
 
-    env = {**os.environ, "MUJOCO_GL": "egl"}
-    preset = preset_path("diffusion_head_only")
-    train = [sys.executable, "-m", "lerobot.scripts.lerobot_train", f"--config_path={preset}",
-             "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", *SMALL_RUN, "--steps=2",
-             "--env_eval_freq=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", "--eval.n_episodes=1",
-             "--eval.batch_size=1", "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'train'}"]
-    subprocess.run(train, check=True, capture_output=True, env=env, timeout=600)
+    _lerobot_train_in_this_process(
+        monkeypatch, f"--config_path={preset_path('diffusion_head_only')}", "--dataset.repo_id=local/tiny",
+        f"--dataset.root={dataset_root}", *SMALL_RUN, "--steps=2", "--env_eval_freq=2", "--save_freq=2",
+        "--batch_size=2", "--num_workers=0", "--eval.n_episodes=1", "--eval.batch_size=1",
+        "--eval.use_async_envs=false", f"--output_dir={tmp_path / 'train'}")
     (periodic,) = [json.loads(line) for line in (tmp_path / "train" / "episodes.jsonl").read_text().splitlines()]
     assert periodic["task"] == "conditional_pick" and periodic["camera_mode"] == "head_only"
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
