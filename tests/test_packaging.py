@@ -46,7 +46,7 @@ def _make_setup(tmp_path, *settings: str) -> tuple[subprocess.CompletedProcess, 
 def test_setup_with_cpu_installs_torch_from_the_cpu_index_before_the_package(tmp_path):
     result, calls = _make_setup(tmp_path)
     assert result.returncode == 0 and not [call for call in calls if "--index-url" in call]
-    assert calls[-1] == f"-m uv pip install --compile-bytecode --python {tmp_path}/venv/bin/python -e .[dev]"
+    assert calls[-1] == f"-m uv pip install --python {tmp_path}/venv/bin/python -e .[dev]"
     (tmp_path / "index" / "whl" / "cpu" / "torch").mkdir(parents=True)
     (tmp_path / "index" / "whl" / "cpu" / "torch" / "index.html").write_text("<html></html>")
     serve = partial(SimpleHTTPRequestHandler, directory=str(tmp_path / "index"))
