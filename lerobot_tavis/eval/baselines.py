@@ -5,13 +5,16 @@ The file is a JSON list of entries, one per (robot, task, camera_mode), each
 policy was trained with), `training_seed` lerobot-train's seed, and `results` the path, relative to the repository
 root, of the `results.json` that `tavis eval` / `tavis report` wrote for that policy. That file must have been played
 by that robot in that camera mode (its `sources` say so) and hold the task's `id` cell. `tavis table-add` adds or
-replaces one entry (`add_entry`: checked, under a lock, written whole); `tavis table` and `tavis ablation` read them.
+replaces one entry (`add_entry`: checked, under a lock, written whole); `tavis table` (under the same lock, so that
+cells finishing together write their tables in turn) and `tavis ablation` read them.
 """
 
 from __future__ import annotations
 
 import json
 import time
+from collections.abc import Iterator
+from contextlib import ExitStack, contextmanager
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -25,7 +28,9 @@ from lerobot_tavis.readers import expect, read_json
 
 BASELINES_PATH = Path("docs/results/baselines.json")  # relative to the repository root
 CONDITIONS = ("head_wrist", "fixed_wrist")  # the paper's two conditions: its headcam and fixedcam
-LOCK_ATTEMPTS, LOCK_WAIT_S = 100, 0.1  # another writer holds the file for milliseconds: wait up to 10 s for it
+# Another process holds the file's lock for milliseconds (an entry) or a few seconds (a table and its plot): wait
+# up to a minute for it.
+LOCK_ATTEMPTS, LOCK_WAIT_S = 600, 0.1
 
 
 @dataclass(frozen=True)
@@ -127,17 +132,29 @@ def add_entry(path: str | Path, entry: Entry, root: str | Path = ".") -> Path:
     folder); the file is rewritten whole, in table order, one writer at a time."""
     path = Path(path)
     check_entry(entry, Path(root), "the new entry")
-    for attempt in range(LOCK_ATTEMPTS):  # cells finishing together take turns
-        try:
-            with exclusive_output(path):
-                entries = _parsed_entries(path) if path.exists() else []
-                kept = [old for old in entries if old.key != entry.key] + [entry]
-                kept.sort(key=lambda e: (e.robot, task_sort_key(e.task), CONDITIONS.index(e.camera_mode)))
-                return write_text(path, json.dumps([asdict(e) for e in kept], indent=2) + "\n")
-        except OutputInUseError:
-            if attempt == LOCK_ATTEMPTS - 1:
-                raise
-            time.sleep(LOCK_WAIT_S)
+    with baselines_turn(path):
+        entries = _parsed_entries(path) if path.exists() else []
+        kept = [old for old in entries if old.key != entry.key] + [entry]
+        kept.sort(key=lambda e: (e.robot, task_sort_key(e.task), CONDITIONS.index(e.camera_mode)))
+        return write_text(path, json.dumps([asdict(e) for e in kept], indent=2) + "\n")
+
+
+@contextmanager
+def baselines_turn(path: str | Path) -> Iterator[None]:
+    """Hold the lock of the baselines file at `path` for the block, waiting for it while another process holds it:
+    cells that finish together add their entries and rewrite the table one after the other (OutputInUseError after
+    LOCK_ATTEMPTS tries)."""
+    for attempt in range(LOCK_ATTEMPTS):
+        with ExitStack() as held:
+            try:
+                held.enter_context(exclusive_output(path))
+            except OutputInUseError:
+                if attempt == LOCK_ATTEMPTS - 1:
+                    raise
+                time.sleep(LOCK_WAIT_S)
+                continue
+            yield
+            return
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -19,7 +19,8 @@ from lerobot_tavis.atomic import write_text
 from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.tasks.catalog import suite_tasks
 from lerobot_tavis.errors import InputError, PathNotFoundError
-from lerobot_tavis.eval.baselines import BASELINES_PATH, CONDITIONS, Entry, read_entries, read_results
+from lerobot_tavis.eval.baselines import (BASELINES_PATH, CONDITIONS, Entry, baselines_turn, read_entries,
+                                         read_results)
 from lerobot_tavis.metrics.stats import wilson_interval
 
 ROBOTS = ("gr1t2", "reachy2")
@@ -224,17 +225,22 @@ class TableConfig:
 
 
 def run_table(cfg: TableConfig) -> list[str]:
-    entries = read_entries(cfg.baselines, cfg.root)
-    text = table_markdown(entries, cfg.root)
-    written = []
-    if cfg.readme is not None:
-        if not cfg.readme.is_file():
-            raise PathNotFoundError(f"--readme {cfg.readme}: no such file")
-        readme = with_table(cfg.readme.read_text(), table_body(entries, cfg.root), cfg.readme)
-        written.append(str(write_text(cfg.readme, readme)))
-    if cfg.out_dir is not None:
-        written += [str(write_text(cfg.out_dir / "baselines.md", text)),
-                    str(table_plot(entries, cfg.root, cfg.out_dir / "baselines.png"))]
+    """The table of the baselines file's entries, written where `cfg` asks (else returned), holding the file's lock
+    (`baselines_turn`): two tables written at once would write the same files at once."""
+    if not Path(cfg.baselines).is_file():  # before its lock, which would make the folder
+        raise PathNotFoundError(f"{cfg.baselines}: missing")
+    if cfg.readme is not None and not cfg.readme.is_file():
+        raise PathNotFoundError(f"--readme {cfg.readme}: no such file")
+    with baselines_turn(cfg.baselines):
+        entries = read_entries(cfg.baselines, cfg.root)
+        text = table_markdown(entries, cfg.root)
+        written = []
+        if cfg.readme is not None:
+            readme = with_table(cfg.readme.read_text(), table_body(entries, cfg.root), cfg.readme)
+            written.append(str(write_text(cfg.readme, readme)))
+        if cfg.out_dir is not None:
+            written += [str(write_text(cfg.out_dir / "baselines.md", text)),
+                        str(table_plot(entries, cfg.root, cfg.out_dir / "baselines.png"))]
     return written or [text]
 
 

@@ -164,6 +164,29 @@ def test_add_entry_waits_for_another_writer_of_the_file(tmp_path):
     assert [e["results"] for e in json.loads(baselines.read_text())] == ["cell/results.json"]
 
 
+def test_a_table_waits_for_another_writer_of_the_baselines_file(tmp_path):
+    """Cells that finish together each rewrite the table (benchmarks/baselines.sh): one at a time, else both write
+    the same partial files and one rename finds its file gone."""
+    import threading
+
+    from lerobot_tavis.eval.baselines_table import TableConfig, run_table
+    from lerobot_tavis.locking import exclusive_output
+
+    results = _results(tmp_path, "cell", "gr1t2", "head_wrist", ("clutter_pick_cube", "id", 50, 96, 0.5))
+    baselines = tmp_path / "baselines.json"
+    add_entry(baselines, _entry("gr1t2", "clutter_pick_cube", "head_wrist", results), tmp_path)
+    table = threading.Thread(target=run_table, args=(TableConfig(baselines=baselines, root=tmp_path, out_dir=tmp_path / "out"),))
+    with exclusive_output(baselines):  # another cell adding its entry or writing its table
+        table.start()
+        table.join(1.0)
+        assert table.is_alive() and not (tmp_path / "out").exists()
+    table.join(60)
+    assert (tmp_path / "out" / "baselines.md").is_file() and (tmp_path / "out" / "baselines.png").is_file()
+    with pytest.raises(PathNotFoundError, match="missing"):
+        run_table(TableConfig(baselines=tmp_path / "none" / "baselines.json", root=tmp_path))
+    assert not (tmp_path / "none").exists()
+
+
 def test_the_ablation_pairs_the_head_policies_and_shows_the_hands_policy_beside_them(tmp_path):
     import shutil
 
