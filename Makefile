@@ -1,9 +1,9 @@
 # Two entry points for a fresh machine: `make demo` and `make test`. Both create .venv with Python 3.12 when
 # missing and install the package (editable, with its extras) into it, with uv: the same packages from PyPI as pip
 # would install, downloaded and unpacked in parallel. Modules are compiled to bytecode when first imported, as
-# Python does by default, and kept: of the ~21,000 installed files the tests import about a fifth, so compiling all
-# at install (pip's way) costs more than it saves. An environment that sets PYTHONDONTWRITEBYTECODE would have
-# every process compile torch and LeRobot again, so the targets below clear it.
+# Python does by default, and kept: the demo and the tests import a small part of what is installed, so compiling
+# all of it at install (pip's way) costs more than it saves. An environment that sets PYTHONDONTWRITEBYTECODE would
+# have every process compile torch and LeRobot again, so the targets below clear it.
 
 VENV := .venv
 STAMP := $(VENV)/.installed

@@ -90,8 +90,6 @@ def children_skip_main_module() -> Iterator[None]:
         yield
     finally:
         main.__dict__.update(saved)
-        if "__spec__" not in saved:
-            del main.__spec__
 
 
 @contextlib.contextmanager

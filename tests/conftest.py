@@ -1,6 +1,7 @@
 import fcntl
 import os
 import shutil
+import socket
 import sys
 from pathlib import Path
 
@@ -52,6 +53,13 @@ def small_env():
     yield make
     for env in envs:
         env.close()
+
+
+def free_port() -> int:
+    """A TCP port of the loopback interface that was free a moment ago (connecting to it is refused at once)."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
 
 
 def run_steps(env, action, steps: int):

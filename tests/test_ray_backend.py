@@ -3,7 +3,6 @@ results, for the demonstrator protocol and for recording."""
 
 import json
 import os
-import socket
 import subprocess
 import sys
 from pathlib import Path
@@ -13,22 +12,17 @@ import pytest
 from lerobot_tavis.dataset_tools.raw import Manifest
 from lerobot_tavis.dataset_tools.record import RecordConfig, record
 from lerobot_tavis.eval.protocol import ProtocolConfig, run_protocol
+from tests.conftest import free_port
 
 pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
 RAY = str(Path(sys.executable).with_name("ray"))
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
 @pytest.fixture(scope="module")
 def ray_cluster():
     """A one-node Ray cluster (`ray start --head`), reached as a remote cluster is: through RAY_ADDRESS."""
-    port = _free_port()
+    port = free_port()
     temp_dir = Path(f"/tmp/ray-tavis-{os.getpid()}")  # Ray's socket paths must stay short
     subprocess.run([RAY, "start", "--head", f"--port={port}", "--num-cpus=2", "--num-gpus=0", "--disable-usage-stats",
                     "--include-dashboard=false", f"--temp-dir={temp_dir}"], check=True, capture_output=True)

@@ -8,7 +8,6 @@ import os
 import pickle
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -20,6 +19,7 @@ from lerobot_tavis.cli import main
 from lerobot_tavis.dataset_tools.convert import ConvertConfig, convert
 from lerobot_tavis.dataset_tools.frame_cache import FrameCache, StaleFrameCacheError, cache_dir
 from lerobot_tavis.policy_configs import preset_path
+from tests.conftest import free_port
 
 pytestmark = pytest.mark.slow  # conftest.py: its file starts first
 
@@ -40,13 +40,6 @@ def dataset_root(conditional_pick_raw, tmp_path_factory):
                                  fps=FPS, image_size=TINY, cameras=CAMERAS), progress=False)
     main(["cache-frames", str(root)])
     return root
-
-
-def _free_port() -> int:
-    """A TCP port of the loopback interface that was free a moment ago."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def _run_with_stacks_on_timeout(command: list[str], env: dict, timeout_s: float) -> tuple[int, str]:
@@ -198,7 +191,7 @@ def test_lerobot_train_reads_the_cache_data_parallel_under_accelerate(dataset_ro
     env = {**os.environ, "MUJOCO_GL": "egl", "TAVIS_FRAME_CACHE": "1", "GLOO_SOCKET_IFNAME": "lo"}
     train = [sys.executable, "-m", "accelerate.commands.launch", "--multi_gpu", "--num_processes", "2",
              "--num_machines", "1", "--mixed_precision", "no", "--dynamo_backend", "no",
-             "--main_process_ip", "127.0.0.1", "--main_process_port", str(_free_port()),
+             "--main_process_ip", "127.0.0.1", "--main_process_port", str(free_port()),
              "-m", "lerobot.scripts.lerobot_train", f"--config_path={tmp_path / 'preset.json'}",
              "--dataset.repo_id=local/tiny", f"--dataset.root={dataset_root}", "--env.task=conditional_pick",
              "--policy.device=cpu", "--policy.dim_model=32", "--policy.dim_feedforward=64", "--policy.n_heads=2",

@@ -1,7 +1,6 @@
 """Dataset card, push and pull. No test reaches the network: the Hub endpoint is a closed local port, and the
 successful push runs against fakes of the huggingface_hub calls that upload."""
 
-import socket
 from pathlib import Path
 
 import httpx
@@ -10,6 +9,7 @@ import pytest
 
 from lerobot_tavis.dataset_tools.features import dataset_features
 from lerobot_tavis.dataset_tools.hub import HubError, dataset_card, pull_dataset, push_dataset
+from tests.conftest import free_port
 
 REPO_ID = "someone/tavis_toy"
 EPISODES = (("conditional_pick", "id", "Look at the card."), ("wait_then_act", "id", "Watch the light."),
@@ -53,10 +53,7 @@ def hub(monkeypatch, tmp_path):
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setattr(constants, "HF_TOKEN_PATH", str(tmp_path / "no_token"))
     monkeypatch.setattr(constants, "HF_HUB_OFFLINE", False)
-    with socket.socket() as probe:  # a port that was free a moment ago: connecting to it is refused at once
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    endpoint = f"http://127.0.0.1:{port}"
+    endpoint = f"http://127.0.0.1:{free_port()}"  # nothing listens there: connecting is refused at once
     monkeypatch.setattr(constants, "ENDPOINT", endpoint)
     return endpoint
 

@@ -1,6 +1,7 @@
 """`process.without_realtime_priority`: an AV1 encoder opened inside it leaves every thread at normal scheduling."""
 
 import json
+import os
 import subprocess
 import sys
 
@@ -46,8 +47,6 @@ print(json.dumps({"capable": capable, **policies, "restored": _set_effective_cap
 def test_an_av1_encoder_cannot_make_a_guarded_thread_real_time():
     """Unguarded, SVT-AV1 moves its thread to SCHED_FIFO where the process may (root, as on CI); guarded it
     cannot, and the guard gives the capability back at its end."""
-    import os
-
     done = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, timeout=120, check=True)
     report = json.loads(done.stdout.strip().splitlines()[-1])
     assert report["guarded"] == os.SCHED_OTHER and report["main"] == os.SCHED_OTHER
