@@ -52,10 +52,11 @@ def test_demonstrator_protocol_on_ray_equals_local(tmp_path, ray_cluster):
     assert not list((tmp_path / "ray").glob(".*"))
 
 
-def test_recording_on_ray_equals_local(tmp_path, ray_cluster):
-    common = dict(robot="gr1t2", tasks=("occluded_reach",), episodes_per_task=2)
-    local = record(RecordConfig(out_dir=tmp_path / "local", **common), progress=False)
-    remote = record(RecordConfig(out_dir=tmp_path / "ray", workers=2, backend="ray", **common), progress=False)
+def test_recording_on_ray_equals_local(tmp_path, ray_cluster, conditional_pick_raw):
+    """Against the run's local recording (tests/conftest.py: the same robot, task, count and seeds)."""
+    local = Manifest.load(conditional_pick_raw)
+    remote = record(RecordConfig(out_dir=tmp_path / "ray", robot="gr1t2", tasks=("conditional_pick",),
+                                 episodes_per_task=2, workers=2, backend="ray"), progress=False)
     entries = [sorted((e.seed, e.success, e.n_steps, e.sha256) for e in m.episodes) for m in (local, remote)]
     assert entries[0] == entries[1] and len(entries[0]) >= 2
     assert Manifest.load(tmp_path / "ray").episodes  # the manifest on disk, written by this process
