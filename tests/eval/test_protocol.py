@@ -281,16 +281,27 @@ def _tiny_policy_cell(checkpoint, out, suite: str, tasks: tuple[str, ...], **set
 def test_policy_chunks_share_workers_without_changing_results_and_keep_the_first_videos(tmp_path,
                                                                                         diffusion_checkpoint):
     """Each chunk is one lerobot-eval run seeded with its first seed: two workers give the cell of one. One task's
-    two chunks (the cell's order over tasks, whatever the finishing order: the demonstrators' test above)."""
-    tasks = ("conditional_pick",)
-    one = _tiny_policy_cell(diffusion_checkpoint, tmp_path / "one", "tavis_head", tasks, workers=1, chunk_episodes=1)
-    assert one == _tiny_policy_cell(diffusion_checkpoint, tmp_path / "two", "tavis_head", tasks, workers=2,
-                                    chunk_episodes=1)
+    two chunks (the cell's order over tasks, whatever the finishing order: the demonstrators' test above). The
+    filmed chunk's videos are annotated as it finishes (by the annotator's processes while the next chunk plays), so
+    the cell of one worker, played without a report, holds its copies."""
+    cfg = ProtocolConfig(out_dir=tmp_path / "one", suites=("tavis_head",), tasks=("conditional_pick",), splits=("id",),
+                         n_episodes=2, image_size=(32, 48), episode_length_s=0.5,
+                         policy_path=str(diffusion_checkpoint), policy_options=(("num_inference_steps", 1),),
+                         workers=1, chunk_episodes=1)
+    run_cells(cfg, [Cell("tavis_head", "id")], run_identity(cfg))
+    cell = tmp_path / "one" / "tavis_head__id"
+    video = cell / "videos" / "tavis_head_0" / "eval_episode_0.mp4"
+    copy = cell / "videos_annotated" / "tavis_head_0" / "eval_episode_0.mp4"
+    assert video.stat().st_size > 0 and copy.stat().st_mtime_ns > video.stat().st_mtime_ns
+    assert sorted(path.name for path in cell.rglob("*.mp4")) == ["eval_episode_0.mp4"] * 2
+    one = _cell_files(tmp_path / "one", "tavis_head__id")
+    assert one == _tiny_policy_cell(diffusion_checkpoint, tmp_path / "two", "tavis_head", ("conditional_pick",),
+                                    workers=2, chunk_episodes=1)
     records = [json.loads(line) for line in one[0].splitlines()]
     assert [(r["task_id"], r["seed"]) for r in records] == [(0, 1000), (0, 1001)]
     videos = one[1]["per_task"][0]["metrics"]["video_paths"]
     assert videos == ["videos/tavis_head_0/eval_episode_0.mp4"]  # from the chunk of seed 1000 only
-    assert (tmp_path / "one" / "tavis_head__id" / videos[0]).stat().st_size > 0
+    assert not [path for path in write_report(tmp_path / "one") if path.suffix == ".mp4"]
 
 
 def test_filming_changes_no_result_and_zero_films_nothing(tmp_path, diffusion_checkpoint):
@@ -415,19 +426,3 @@ def test_the_eval_config_of_a_checkpoint_does_not_warn_of_random_weights(caplog)
     assert cfg.policy.pretrained_path == "ckpt"
     with pytest.raises(ValueError, match="pretrained_path"):
         pipeline_config(env=TavisEnvConfig(), policy=DiffusionConfig(), job_name="probe")
-
-
-def test_a_policy_run_annotates_its_videos_while_it_plays(tmp_path, diffusion_checkpoint):
-    """Each filmed chunk's videos are annotated as it finishes (by the annotator's processes while the next chunk
-    plays), so the cell holds its copies before any report."""
-    cfg = ProtocolConfig(out_dir=tmp_path / "eval", suites=("tavis_hands",), tasks=("peeking_box",), splits=("id",),
-                         n_episodes=2, image_size=(32, 48), episode_length_s=0.5,
-                         policy_path=str(diffusion_checkpoint), policy_options=(("num_inference_steps", 1),),
-                         chunk_episodes=1, film_episodes=1)
-    run_cells(cfg, [Cell("tavis_hands", "id")], run_identity(cfg))
-    cell = tmp_path / "eval" / "tavis_hands__id"
-    video = cell / "videos" / "tavis_hands_0" / "eval_episode_0.mp4"
-    copy = cell / "videos_annotated" / "tavis_hands_0" / "eval_episode_0.mp4"
-    assert copy.stat().st_mtime_ns > video.stat().st_mtime_ns
-    assert sorted(path.name for path in cell.rglob("*.mp4")) == ["eval_episode_0.mp4"] * 2
-    assert not [path for path in write_report(tmp_path / "eval") if path.suffix == ".mp4"]
