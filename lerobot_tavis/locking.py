@@ -12,6 +12,7 @@ import fcntl
 import os
 import shlex
 import sys
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -31,13 +32,17 @@ def lock_path(directory: str | Path) -> Path:
     return directory.with_name(f".{hidden_stem(directory.name, len('lock'))}.lock")
 
 
+RETRY_S = 0.1  # how often a waiting process tries the lock again
+
+
 @contextmanager
-def exclusive_output(directory: str | Path) -> Iterator[None]:
+def exclusive_output(directory: str | Path, wait_s: float = 0.0) -> Iterator[None]:
     """Hold `directory`'s lock for the block; OutputInUseError naming the holder (pid, command line) when another
-    process holds it. The directory itself is neither needed nor created; its parent is. The lock file is removed
-    when the block ends (a killed run leaves it, unlocked: the next run takes it over)."""
+    process still holds it after `wait_s` seconds (0: refused at once). The directory itself is neither needed nor
+    created; its parent is. The lock file is removed when the block ends (a killed run leaves it, unlocked: the next
+    run takes it over)."""
     path = lock_path(directory)
-    fd = _locked(path, Path(directory))
+    fd = _locked_within(path, Path(directory), wait_s)
     try:
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"pid {os.getpid()} ({shlex.join(_command_line())})\n".encode(), 0)
@@ -45,6 +50,18 @@ def exclusive_output(directory: str | Path) -> Iterator[None]:
     finally:
         path.unlink(missing_ok=True)  # while still locked: a run that opened it before fails, or finds it gone
         os.close(fd)  # releases the lock
+
+
+def _locked_within(path: Path, directory: Path, wait_s: float) -> int:
+    """`_locked`, tried again every RETRY_S while another process holds the lock, until `wait_s` seconds have passed."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            return _locked(path, directory)
+        except OutputInUseError:
+            if time.monotonic() >= deadline:
+                raise
+            time.sleep(RETRY_S)
 
 
 def _locked(path: Path, directory: Path) -> int:

@@ -12,9 +12,6 @@ cells finishing together write their tables in turn) and `tavis ablation` read t
 from __future__ import annotations
 
 import json
-import time
-from collections.abc import Iterator
-from contextlib import ExitStack, contextmanager
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -23,14 +20,14 @@ from lerobot_tavis.cli_options import option
 from lerobot_tavis.envs.robots import robot_names
 from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_sort_key
 from lerobot_tavis.errors import InputError, PathNotFoundError
-from lerobot_tavis.locking import OutputInUseError, exclusive_output
+from lerobot_tavis.locking import exclusive_output
 from lerobot_tavis.readers import expect, read_json
 
 BASELINES_PATH = Path("docs/results/baselines.json")  # relative to the repository root
 CONDITIONS = ("head_wrist", "fixed_wrist")  # the paper's two conditions: its headcam and fixedcam
 # Another process holds the file's lock for milliseconds (an entry) or a few seconds (a table and its plot): wait
-# up to a minute for it.
-LOCK_ATTEMPTS, LOCK_WAIT_S = 600, 0.1
+# up to a minute (s) for it.
+TURN_WAIT_S = 60.0
 
 
 @dataclass(frozen=True)
@@ -139,22 +136,10 @@ def add_entry(path: str | Path, entry: Entry, root: str | Path = ".") -> Path:
         return write_text(path, json.dumps([asdict(e) for e in kept], indent=2) + "\n")
 
 
-@contextmanager
-def baselines_turn(path: str | Path) -> Iterator[None]:
-    """Hold the lock of the baselines file at `path` for the block, waiting for it while another process holds it:
-    cells that finish together add their entries and rewrite the table one after the other (OutputInUseError after
-    LOCK_ATTEMPTS tries)."""
-    for attempt in range(LOCK_ATTEMPTS):
-        with ExitStack() as held:
-            try:
-                held.enter_context(exclusive_output(path))
-            except OutputInUseError:
-                if attempt == LOCK_ATTEMPTS - 1:
-                    raise
-                time.sleep(LOCK_WAIT_S)
-                continue
-            yield
-            return
+def baselines_turn(path: str | Path):
+    """The lock of the baselines file at `path`, waited for up to TURN_WAIT_S while another process holds it: cells
+    that finish together add their entries and rewrite the table one after the other."""
+    return exclusive_output(path, wait_s=TURN_WAIT_S)
 
 
 @dataclass(frozen=True, kw_only=True)
