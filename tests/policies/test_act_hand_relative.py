@@ -118,6 +118,45 @@ def test_an_amp_dtype_other_than_bfloat16_or_float16_is_refused():
         config.validate_features()
 
 
+def test_group_norm_normalises_the_resnet_trains_and_survives_a_checkpoint(dataset_root, tmp_path):
+    """backbone_norm group_norm: every frozen batch norm of the ResNet becomes a trained GroupNorm (16 channels a
+    group), and a checkpoint rebuilds that network with its weights."""
+    from torch import nn
+    from torchvision.ops.misc import FrozenBatchNorm2d
+
+    root, episodes = dataset_root
+    torch.manual_seed(0)
+    policy = ACTHandRelativePolicy(_config(backbone_norm="group_norm"), dataset_stats=_action_stats(episodes),
+                                   dataset_meta=SimpleNamespace(root=root, fps=20))
+    norms = [m for m in policy.model.backbone.modules() if isinstance(m, (nn.GroupNorm, FrozenBatchNorm2d))]
+    assert len(norms) == 20 and all(isinstance(m, nn.GroupNorm) and m.num_channels == 16 * m.num_groups
+                                    for m in norms)
+    batch, _ = _batch(np.random.default_rng(1), policy, 2)
+    loss, _ = policy.forward(batch)
+    loss.backward()
+    assert torch.isfinite(loss) and all(m.weight.grad.abs().sum() > 0 for m in norms)
+    with torch.no_grad():
+        norms[0].weight.add_(0.5)  # a trained scale, which the checkpoint must keep
+    policy.save_pretrained(tmp_path)
+    loaded = ACTHandRelativePolicy.from_pretrained(tmp_path)
+    assert loaded.config.backbone_norm == "group_norm"
+    policy.eval(), loaded.eval()
+    for each in (policy, loaded):
+        each.reset()
+    torch.testing.assert_close(loaded.predict_action_chunk(batch), policy.predict_action_chunk(batch))
+
+
+def test_a_backbone_norm_other_than_its_two_or_group_norm_on_pretrained_weights_is_refused():
+    with pytest.raises(ValueError, match="backbone_norm must be one of frozen_batch_norm, group_norm; got 'batch'"):
+        _config(backbone_norm="batch")
+    with pytest.raises(ValueError, match="pretrained_backbone_weights must be None, got 'ResNet18_Weights"):
+        _config(backbone_norm="group_norm", pretrained_backbone_weights="ResNet18_Weights.IMAGENET1K_V1")
+    config = _config()
+    config.backbone_norm = "layer_norm"  # as `tavis eval --policy-option backbone_norm=layer_norm` sets it
+    with pytest.raises(ValueError, match="got 'layer_norm'"):
+        config.validate_features()
+
+
 def test_a_predicted_chunk_comes_back_absolute_anchored_on_the_state_it_was_planned_from(policy, monkeypatch):
     batch, absolute = _batch(np.random.default_rng(2), policy, 2)
     planned_from = batch[OBS_STATE]

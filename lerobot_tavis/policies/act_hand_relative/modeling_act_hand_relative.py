@@ -8,12 +8,14 @@ state it was planned from, before ACT queues (or ensembles) it. The processors a
 from __future__ import annotations
 
 import torch
-from torch import Tensor
+from torch import Tensor, nn
+from torchvision.ops.misc import FrozenBatchNorm2d
 
 from lerobot.policies.act.modeling_act import ACTPolicy
 from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_STATE
 
-from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import ACTHandRelativeConfig
+from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import (GROUP_NORM_CHANNELS,
+                                                                                      ACTHandRelativeConfig)
 from lerobot_tavis.policies.hand_relative import HandRelativeChunks
 
 
@@ -26,6 +28,8 @@ class ACTHandRelativePolicy(HandRelativeChunks, ACTPolicy):
         """Built for training with the dataset's statistics (`dataset_stats`) and files (`dataset_meta.root`), as
         LeRobot's `make_policy` passes them; `from_pretrained` builds it without and loads the saved buffers."""
         super().__init__(config, **kwargs)
+        if config.backbone_norm == "group_norm" and config.image_features:
+            _group_normalise(self.model.backbone)
         self._register_statistics(dataset_stats, dataset_meta, range(config.chunk_size))
 
     def forward(self, batch: dict[str, Tensor]) -> tuple[Tensor, dict]:
@@ -53,3 +57,14 @@ class ACTHandRelativePolicy(HandRelativeChunks, ACTPolicy):
         with self._amp_precision(state.device):
             relative = super().predict_action_chunk(batch)
         return self._from_network_chunk(relative, state)
+
+
+def _group_normalise(module: nn.Module) -> None:
+    """Puts a GroupNorm (GROUP_NORM_CHANNELS channels a group, unit scale, zero shift) in place of every frozen
+    batch norm under `module`."""
+    for name, child in module.named_children():
+        if isinstance(child, FrozenBatchNorm2d):
+            channels = child.weight.shape[0]
+            setattr(module, name, nn.GroupNorm(channels // GROUP_NORM_CHANNELS, channels))
+        else:
+            _group_normalise(child)
