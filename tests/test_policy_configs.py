@@ -151,14 +151,15 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
     assert info["overall"]["n_episodes"] == 1
 
 
-@pytest.mark.parametrize(("name", "policy_type"), [("act_head_wrist_compact", "act"),
-                                                  ("act_hand_relative_head_wrist_compact", "act_hand_relative")])
+@pytest.mark.parametrize(("name", "policy_type", "options"), [
+    ("act_head_wrist_compact", "act", {}),
+    ("act_hand_relative_head_wrist_compact", "act_hand_relative", {"backbone_norm": "group_norm"})])
 def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, name,
-                                                                             policy_type, monkeypatch):
+                                                                             policy_type, options, monkeypatch):
     """benchmarks/train_baseline.sh's STATE_INPUT=off: the compact preset's inputs less observation.state; the
     hand-frame preset, whose policy type this package registers (a lerobot-train process of its own finds it through
     the plugin in tests/dataset_tools/test_frame_cache.py), with its time input (a feature no dataset holds; the
-    policy without it trains and acts in tests/policies)."""
+    policy without it trains and acts in tests/policies) and its ResNet group-normalised from the command line."""
     preset = json.loads(preset_path(name).read_text())
     preset["policy"]["input_features"].pop("observation.state", None)
     for feature in preset["policy"]["input_features"].values():
@@ -168,11 +169,13 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
         monkeypatch, f"--config_path={tmp_path / 'preset.json'}", "--dataset.repo_id=local/tiny",
         f"--dataset.root={dataset_root}", "--env.task=conditional_pick", "--policy.device=cpu",
         "--policy.dim_model=32", "--policy.dim_feedforward=64", "--policy.n_heads=2", "--steps=2", "--save_freq=2",
-        "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}")
+        "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}",
+        *(f"--policy.{key}={value}" for key, value in options.items()))
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
     assert config["type"] == policy_type and "observation.state" not in config["input_features"]
     assert config.get("time_input", False) is (policy_type == "act_hand_relative")
+    assert {key: config[key] for key in options} == options
     _one_short_episode(checkpoint, tmp_path / "eval")
 
 
