@@ -9,10 +9,11 @@
 #                                             `tavis table` writes baselines.md and baselines.png beside BASELINES
 #                                             and the table into the README.md there (docs/results/README.md)
 #
-# One recipe for every cell: the `act_hand_relative_<condition>_compact` presets, EPISODES (160) demonstrations,
-# STEPS (3200) steps of BATCH (128), training seed SEED (1000), the last checkpoint evaluated on EVAL_EPISODES (96)
-# episodes from seed 1000 of the id split, head_wrist also on ood_spatial and ood_init_pose. Training and evaluation
-# are benchmarks/train_baseline.sh's (`pair`, or `cell` when one condition is left), one recording per (robot, task).
+# One recipe for every cell: the `act_hand_relative_<condition>_compact` presets (their files' SHA-256 are part of the
+# recipe, so an edited preset is another recipe), EPISODES (160) demonstrations, STEPS (3200) steps of BATCH (128),
+# training seed SEED (1000), the last checkpoint evaluated on EVAL_EPISODES (96) episodes from seed 1000 of the id
+# split, head_wrist also on ood_spatial and ood_init_pose. Training and evaluation are benchmarks/train_baseline.sh's
+# (`pair`, or `cell` when one condition is left), one recording per (robot, task).
 # A finished condition becomes RESULTS/<robot>/<task>/<condition>/: the `tavis eval` output without videos, the
 # training config (train_config.json), the run's log (log.txt, each progress bar's last state), the model card
 # (model_card.md) and recipe.json (the recipe, the commit, the machine, the command). That folder is moved into
@@ -51,10 +52,13 @@ cd "$ROOT"
 
 # Prints the recipe (JSON: what every cell of one table shares); with a recipe.json as argument, compares instead
 # and fails with a message when that file records another recipe; with `write FILE COMMAND`, writes a recipe.json.
-RECIPE='import json, os, platform, subprocess, sys
+RECIPE='import hashlib, json, os, platform, subprocess, sys
+from lerobot_tavis.policy_configs import preset_path
 env = os.environ
-recipe = {"presets": "act_hand_relative_<condition>_compact", "demonstrations": int(env["EPISODES"]),
-          "steps": int(env["STEPS"]), "batch_size": int(env["BATCH"]), "training_seed": int(env["SEED"]),
+presets = {condition: hashlib.sha256(preset_path(f"act_hand_relative_{condition}_compact").read_bytes()).hexdigest()
+           for condition in ("head_wrist", "fixed_wrist")}
+recipe = {"presets": "act_hand_relative_<condition>_compact", "preset_sha256": presets,
+          "demonstrations": int(env["EPISODES"]), "steps": int(env["STEPS"]), "batch_size": int(env["BATCH"]), "training_seed": int(env["SEED"]),
           "image_size": "120x160", "device": env["DEVICE"],
           "evaluation": {"episodes": int(env["EVAL_EPISODES"]), "first_seed": 1000, "checkpoint": "last",
                          "splits": {"head_wrist": ["id", "ood_spatial", "ood_init_pose"], "fixed_wrist": ["id"]}}}

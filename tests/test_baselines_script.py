@@ -115,6 +115,15 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
     assert other.returncode == 2
     assert "was made with another recipe (training_seed differ)" in other.stderr
     assert not _calls(tmp_path, "lerobot-train")
+    recipe_file = tmp_path / "results" / "gr1t2" / "clutter_pick_cube" / "head_wrist" / "recipe.json"
+    made_with = recipe_file.read_text()
+    edited = json.loads(made_with)  # as if the cell had been made before a preset was edited
+    edited["recipe"]["preset_sha256"]["head_wrist"] = "0" * 64
+    recipe_file.write_text(json.dumps(edited))
+    edited_preset = _baselines(tmp_path, "cell", "gr1t2", "clutter_pick_cube")
+    assert edited_preset.returncode == 2
+    assert "was made with another recipe (preset_sha256 differ)" in edited_preset.stderr
+    recipe_file.write_text(made_with)
 
     lost = tmp_path / "results" / "gr1t2" / "clutter_pick_cube" / "fixed_wrist"  # the machine went mid-cell: the
     subprocess.run(["rm", "-r", str(lost), str(tmp_path / "work")], check=True)  # results kept are those committed
