@@ -45,7 +45,7 @@ def dataset_root(conditional_pick_raw, tmp_path_factory):
 
 
 TRAINING_ENDED = "End of training"  # lerobot-train's main process, once the last checkpoint is written
-TEARDOWN_GRACE_S = 20  # s; the ranks have passed their last barrier by then and normally exit within seconds
+TEARDOWN_GRACE_S = 10  # s; the ranks have passed their last barrier by then and normally exit within 2-3 s
 
 
 def _run_training(command: list[str], env: dict, timeout_s: float) -> tuple[int | None, str]:
@@ -73,12 +73,13 @@ def _run_training(command: list[str], env: dict, timeout_s: float) -> tuple[int 
     else:
         reader.join()
         return process.returncode, "".join(lines)
-    tree = [process.pid, *(child.pid for child in psutil.Process(process.pid).children(recursive=True))]
-    for signal_number in (signal.SIGABRT, signal.SIGKILL):
-        for pid in tree:
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(pid, signal_number)
-        time.sleep(5)
+    root = psutil.Process(process.pid)
+    tree = [root, *root.children(recursive=True)]
+    for signal_number in (signal.SIGABRT, signal.SIGKILL):  # the stacks (faulthandler), then the end
+        for member in tree:
+            with contextlib.suppress(psutil.NoSuchProcess):
+                member.send_signal(signal_number)
+        tree = psutil.wait_procs(tree, timeout=5)[1]  # those still alive
     process.wait()
     reader.join()
     output = "".join(lines)
