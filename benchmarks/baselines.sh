@@ -58,8 +58,8 @@ env = os.environ
 presets = {condition: hashlib.sha256(preset_path(f"act_hand_relative_{condition}_compact").read_bytes()).hexdigest()
            for condition in ("head_wrist", "fixed_wrist")}
 recipe = {"presets": "act_hand_relative_<condition>_compact", "preset_sha256": presets,
-          "demonstrations": int(env["EPISODES"]), "steps": int(env["STEPS"]), "batch_size": int(env["BATCH"]), "training_seed": int(env["SEED"]),
-          "image_size": "120x160", "device": env["DEVICE"],
+          "demonstrations": int(env["EPISODES"]), "steps": int(env["STEPS"]), "batch_size": int(env["BATCH"]),
+          "training_seed": int(env["SEED"]), "image_size": "120x160", "device": env["DEVICE"],
           "evaluation": {"episodes": int(env["EVAL_EPISODES"]), "first_seed": 1000, "checkpoint": "last",
                          "splits": {"head_wrist": ["id", "ood_spatial", "ood_init_pose"], "fixed_wrist": ["id"]}}}
 if len(sys.argv) == 1:
