@@ -45,7 +45,7 @@ def dataset_root(conditional_pick_raw, tmp_path_factory):
 
 
 TRAINING_ENDED = "End of training"  # lerobot-train's main process, once the last checkpoint is written
-TEARDOWN_GRACE_S = 10  # s; the ranks have passed their last barrier by then and normally exit within 2-3 s
+TEARDOWN_GRACE_S = 10  # s; the ranks have passed their last barrier by then and normally exit within a few seconds
 
 
 def _run_training(command: list[str], env: dict, timeout_s: float) -> tuple[int | None, str]:
