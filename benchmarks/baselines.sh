@@ -7,7 +7,8 @@
 #                                             GPUs at once (4 GPUs: two), each condition on a GPU of its own, the
 #                                             pair's next cell recorded, converted and cached meanwhile; then
 #                                             `tavis table` writes baselines.md and baselines.png beside BASELINES
-#                                             and the table into the README.md there (docs/results/README.md)
+#                                             and the table into the README.md there (docs/results/README.md),
+#                                             `tavis ablation` each robot's ablation_<robot>.md beside them
 #
 # One recipe for every cell: the `act_hand_relative_<condition>_compact` presets (their files' SHA-256 are part of the
 # recipe, so an edited preset is another recipe), EPISODES (160) demonstrations, STEPS (3200) steps of BATCH (128),
@@ -196,10 +197,15 @@ cell() {  # cell ROBOT TASK
   return "$status"
 }
 
-write_table() {  # the table as far as it goes, beside BASELINES and at the top of the README.md there if any
-  local readme
-  readme=$(dirname "$BASELINES")/README.md
-  tavis table --baselines "$BASELINES" --out "$(dirname "$BASELINES")" $([ -f "$readme" ] && echo --readme "$readme")
+write_table() {  # the table as far as it goes, beside BASELINES and at the top of the README.md there if any; each
+  # robot's wrist-only ablation (from three of its cells) beside it as ablation_<robot>.md
+  local out readme robot
+  out=$(dirname "$BASELINES")
+  readme=$out/README.md
+  tavis table --baselines "$BASELINES" --out "$out" $([ -f "$readme" ] && echo --readme "$readme")
+  for robot in $(python3 -c "from lerobot_tavis.envs.robots import robot_names; print(*robot_names())"); do
+    tavis ablation --robot "$robot" --baselines "$BASELINES" --out "$out/ablation_$robot.md" > /dev/null
+  done
 }
 
 check_cell() {  # check_cell ROBOT TASK: both known, else exit 2

@@ -32,11 +32,21 @@ PY
     ;;
   curve|cache-frames) ;;
   eval) out=${@: -1}; mkdir -p "$out/tavis_head__id/videos" "$out/.tavis_head__id.chunks"
-    format='{"cells": [{"task": "%s", "split": "id", "successes": 1, "n": 2}], '
-    format+='"sources": [{"robots": ["%s"], "camera_modes": ["%s"]}]}'
-    printf "$format" \\
-      "$(FLAG=--tasks value "$@")" "$(FLAG=--robot value "$@")" "$(FLAG=--camera-mode value "$@")" \\
-      > "$out/results.json" ;;
+    "$PYTHON" - "$out" "$(FLAG=--tasks value "$@")" "$(FLAG=--robot value "$@")" "$(FLAG=--camera-mode value "$@")" \\
+      <<'PY'  # results.json, and the episodes `tavis ablation` pairs: seed 1000 succeeds, 1001 fails
+import json, os, sys
+out, task, robot, mode = sys.argv[1:]
+json.dump({"cells": [{"task": task, "split": "id", "successes": 1, "n": 2}],
+           "sources": [{"robots": [robot], "camera_modes": [mode]}]}, open(os.path.join(out, "results.json"), "w"))
+cell = os.path.join(out, "tavis_head__id")
+json.dump({"per_task": [{"task_group": "tavis_head", "task_id": 0, "metrics": {"successes": [True, False]}}]},
+          open(os.path.join(cell, "eval_info.json"), "w"))
+with open(os.path.join(cell, "episodes.jsonl"), "w") as log:
+    for seed, success in ((1000, True), (1001, False)):
+        log.write(json.dumps({"robot": robot, "suite": "tavis_head", "task": task, "task_id": 0, "split": "id",
+                              "camera_mode": mode, "seed": seed, "success": success}) + "\\n")
+PY
+    ;;
   push-policy) out=$(FLAG=--out value "$@"); mkdir -p "$out"; echo "card of $(FLAG=--repo-id value "$@")" \\
       > "$out/README.md" ;;
   *) exec "$PYTHON" -m lerobot_tavis.cli "$@" ;;
@@ -83,6 +93,11 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
         assert " --steps=20 --save_freq=20 --batch_size=128" in train and "--steps=1 " not in train
         assert "--seed=1000 " in train and "--env.robot=gr1t2 " in train
     assert "| TAVIS-Head | clutter_pick_cube | 50.0% [" in (tmp_path / "baselines.md").read_text()  # the table too
+    ablation = (tmp_path / "ablation_gr1t2.md").read_text()  # and each robot's ablation, as far as it goes
+    assert "| clutter_pick_cube | fixed_wrist | 50.0% [" in ablation
+    assert "| blocked_clutter_pick_cube | head_wrist | not run |" in ablation
+    assert "2 paired episodes: A 1 successes, B 1; both 1, only A 0, only B 0" in ablation  # the two conditions'
+    assert "| clutter_pick_cube | head_wrist | not run |" in (tmp_path / "ablation_reachy2.md").read_text()
     caches = sorted(call.split()[2] for call in _calls(tmp_path, "tavis cache-frames"))  # trainings read frames there
     assert caches == [str(work / "dataset_fixed_wrist"), str(work / "dataset_head_wrist")]
     evals = {call.split("--camera-mode ")[1].split()[0]: call for call in _calls(tmp_path, "tavis eval")}

@@ -290,8 +290,13 @@ def ablation_markdown(entries: list[Entry], root: Path, robot: str) -> str:
 
 
 def run_ablation(cfg: AblationConfig) -> list[str]:
-    text = ablation_markdown(read_entries(cfg.baselines, cfg.root), cfg.root, cfg.robot)
+    """The ablation's Markdown, also written to `cfg.out` if set, holding the baselines file's lock as `run_table`
+    does: tables and ablations written at once each read the entries of the file as they write."""
     if cfg.out is None:
-        return [text]
-    return [text, str(write_text(cfg.out, text))]
+        return [ablation_markdown(read_entries(cfg.baselines, cfg.root), cfg.root, cfg.robot)]
+    if not Path(cfg.baselines).is_file():  # before its lock, which would make the folder
+        raise PathNotFoundError(f"{cfg.baselines}: missing")
+    with baselines_turn(cfg.baselines):
+        text = ablation_markdown(read_entries(cfg.baselines, cfg.root), cfg.root, cfg.robot)
+        return [text, str(write_text(cfg.out, text))]
 
