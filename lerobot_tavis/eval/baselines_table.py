@@ -12,6 +12,7 @@ numbers as markers.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -224,14 +225,22 @@ class TableConfig:
                                  f"('{README_BEGIN}' and '{README_END}') (default: none)")
 
 
+@contextmanager
+def _existing_baselines_turn(baselines: Path):
+    """The baselines file's lock (`baselines_turn`) once the file is known to exist (the lock would make its folder):
+    tables and ablations written at once would write the same files at once, each from the entries it read."""
+    if not Path(baselines).is_file():
+        raise PathNotFoundError(f"{baselines}: missing")
+    with baselines_turn(baselines):
+        yield
+
+
 def run_table(cfg: TableConfig) -> list[str]:
-    """The table of the baselines file's entries, written where `cfg` asks (else returned), holding the file's lock
-    (`baselines_turn`): two tables written at once would write the same files at once."""
-    if not Path(cfg.baselines).is_file():  # before its lock, which would make the folder
-        raise PathNotFoundError(f"{cfg.baselines}: missing")
+    """The table of the baselines file's entries, written where `cfg` asks (else returned), holding the file's
+    lock."""
     if cfg.readme is not None and not cfg.readme.is_file():
         raise PathNotFoundError(f"--readme {cfg.readme}: no such file")
-    with baselines_turn(cfg.baselines):
+    with _existing_baselines_turn(cfg.baselines):
         entries = read_entries(cfg.baselines, cfg.root)
         text = table_markdown(entries, cfg.root)
         written = []
@@ -290,13 +299,10 @@ def ablation_markdown(entries: list[Entry], root: Path, robot: str) -> str:
 
 
 def run_ablation(cfg: AblationConfig) -> list[str]:
-    """The ablation's Markdown, also written to `cfg.out` if set, holding the baselines file's lock as `run_table`
-    does: tables and ablations written at once each read the entries of the file as they write."""
+    """The ablation's Markdown, also written to `cfg.out` if set (holding the baselines file's lock)."""
     if cfg.out is None:
         return [ablation_markdown(read_entries(cfg.baselines, cfg.root), cfg.root, cfg.robot)]
-    if not Path(cfg.baselines).is_file():  # before its lock, which would make the folder
-        raise PathNotFoundError(f"{cfg.baselines}: missing")
-    with baselines_turn(cfg.baselines):
+    with _existing_baselines_turn(cfg.baselines):
         text = ablation_markdown(read_entries(cfg.baselines, cfg.root), cfg.root, cfg.robot)
         return [text, str(write_text(cfg.out, text))]
 
