@@ -197,20 +197,24 @@ cell() {  # cell ROBOT TASK
   return "$status"
 }
 
+robot_names() {  # the built-in robots, in catalog order
+  python3 -c "from lerobot_tavis.envs.robots import robot_names; print(*robot_names())"
+}
+
 write_table() {  # the table as far as it goes, beside BASELINES and at the top of the README.md there if any; each
   # robot's wrist-only ablation (from three of its cells) beside it as ablation_<robot>.md
   local out readme robot
   out=$(dirname "$BASELINES")
   readme=$out/README.md
   tavis table --baselines "$BASELINES" --out "$out" $([ -f "$readme" ] && echo --readme "$readme")
-  for robot in $(python3 -c "from lerobot_tavis.envs.robots import robot_names; print(*robot_names())"); do
+  for robot in $(robot_names); do
     tavis ablation --robot "$robot" --baselines "$BASELINES" --out "$out/ablation_$robot.md" > /dev/null
   done
 }
 
 check_cell() {  # check_cell ROBOT TASK: both known, else exit 2
   local robots tasks
-  robots=$(python3 -c "from lerobot_tavis.envs.robots import robot_names; print(*robot_names())")
+  robots=$(robot_names)
   tasks=$(python3 -c "from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS; print(*BENCHMARK_TASKS)")
   if [[ " $robots " != *" $1 "* ]] || [[ " $tasks " != *" $2 "* ]]; then
     echo "baselines: ROBOT must be one of: $robots; TASK one of: $tasks; got '$1' '$2'" >&2

@@ -12,7 +12,7 @@ numbers as markers.
 
 from __future__ import annotations
 
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -300,9 +300,7 @@ def ablation_markdown(entries: list[Entry], root: Path, robot: str) -> str:
 
 def run_ablation(cfg: AblationConfig) -> list[str]:
     """The ablation's Markdown, also written to `cfg.out` if set (holding the baselines file's lock)."""
-    if cfg.out is None:
-        return [ablation_markdown(read_entries(cfg.baselines, cfg.root), cfg.root, cfg.robot)]
-    with _existing_baselines_turn(cfg.baselines):
+    with nullcontext() if cfg.out is None else _existing_baselines_turn(cfg.baselines):
         text = ablation_markdown(read_entries(cfg.baselines, cfg.root), cfg.root, cfg.robot)
-        return [text, str(write_text(cfg.out, text))]
+        return [text] if cfg.out is None else [text, str(write_text(cfg.out, text))]
 
