@@ -1,9 +1,11 @@
 """LeRobot's dataset with its video frames read from the frame cache (`frame_cache`), and the switch that makes
 lerobot-train use it: `TAVIS_FRAME_CACHE=1` in lerobot-train's environment (docs/training.md).
 
-Only the frame lookup changes. LeRobot's reader still chooses each sample's rows, delta timestamps, padding flags,
-other features and image transforms; where it would decode a camera's frames at a list of timestamps, this reader
-takes the cache's rows at those timestamps (the nearest within `tolerance_s`, as LeRobot's decoders choose).
+Only the lookups change. LeRobot's reader still chooses each sample's rows, delta timestamps, padding flags and image
+transforms; where it would decode a camera's frames at a list of timestamps, this reader takes the cache's rows at
+those timestamps (the nearest within `tolerance_s`, as LeRobot's decoders choose), and where it would query its
+Hugging Face dataset for a feature's rows (the state, the action chunk, the frames' timestamps), this reader indexes
+that feature's column, read once per process: the same tensors without a query per feature and sample.
 
 The frames come back as LeRobot's decoders return them: uint8 where the dataset is asked for uint8 (`return_uint8`,
 as lerobot-train asks), else float32 in [0, 1] (`x / 255` of the same uint8 frame). lerobot-train converts uint8
@@ -37,13 +39,50 @@ class CachedFrameReader(DatasetReader):
     def __init__(self, frame_cache: FrameCache, **reader_arguments):
         super().__init__(**reader_arguments)
         self.frame_cache = frame_cache
+        self._columns: dict[str, torch.Tensor] = {}
+        self._episode_rows: dict[int, tuple[int, int]] = {}
+
+    def __getstate__(self) -> dict:
+        return {**self.__dict__, "_columns": {}, "_episode_rows": {}}  # each loader worker reads its own once
+
+    def _column(self, key: str) -> torch.Tensor:
+        """Feature `key` of every row of the Hugging Face dataset, stacked in row order: each row as LeRobot's
+        torch transform gives it, read once per process."""
+        if key not in self._columns:
+            self._columns[key] = torch.stack(self.hf_dataset.select_columns([key])[:][key])
+        return self._columns[key]
+
+    def _relative_rows(self, absolute_indices: list[int]) -> list[int]:
+        """The Hugging Face dataset's rows of the dataset's absolute indices (they differ in an episode subset)."""
+        if self._absolute_to_relative_idx is None:
+            return absolute_indices
+        return [self._absolute_to_relative_idx[index] for index in absolute_indices]
+
+    def _query_hf_dataset(self, query_indices: dict[str, list[int]]) -> dict[str, torch.Tensor]:
+        """Per non-video key, its rows at the absolute indices, stacked, as LeRobot's reader returns them; from the
+        in-memory columns instead of a Hugging Face dataset query per key and sample, which costs a loader worker
+        several times the cached frames' read."""
+        return {key: self._column(key)[self._relative_rows(indices)] for key, indices in query_indices.items()
+                if key not in self._meta.video_keys}
+
+    def _get_query_timestamps(self, current_ts: float, query_indices: dict[str, list[int]] | None = None
+                              ) -> dict[str, list[float]]:
+        """Per video key, the timestamps (s) of its query rows (the current one alone where it has no delta
+        timestamps), as LeRobot's reader computes them, from the in-memory timestamp column."""
+        if query_indices is None:
+            return {key: [current_ts] for key in self._meta.video_keys}
+        timestamps = self._column("timestamp")
+        return {key: timestamps[self._relative_rows(query_indices[key])].tolist() if key in query_indices
+                else [current_ts] for key in self._meta.video_keys}
 
     def _query_videos(self, query_timestamps: dict[str, list[float]], ep_idx: int) -> dict[str, torch.Tensor]:
         """Per camera key, the frames at the timestamps (s, within episode `ep_idx`): (channels, height, width) for
         one timestamp, (timestamps, channels, height, width) for several; uint8 with `return_uint8`, else float32
         in [0, 1], as LeRobot's."""
-        episode = self._meta.episodes[ep_idx]
-        start, end = int(episode["dataset_from_index"]), int(episode["dataset_to_index"])
+        if ep_idx not in self._episode_rows:
+            episode = self._meta.episodes[ep_idx]
+            self._episode_rows[ep_idx] = int(episode["dataset_from_index"]), int(episode["dataset_to_index"])
+        start, end = self._episode_rows[ep_idx]
         frames = {}
         for key, timestamps in query_timestamps.items():
             rows = self.frame_cache.rows(start, end, timestamps, self._tolerance_s)

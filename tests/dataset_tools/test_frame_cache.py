@@ -99,17 +99,19 @@ def _assert_same_sample(got: dict, want: dict, index: int) -> None:
             assert got[key] == value, (index, key)
 
 
-@pytest.mark.parametrize("return_uint8", [True, False], ids=["uint8 as lerobot-train asks", "float32"])
-def test_cached_samples_are_lerobots_decoded_samples_without_decoding(dataset_root, monkeypatch, return_uint8):
+@pytest.mark.parametrize(("return_uint8", "episodes"), [(True, None), (False, None), (True, [1])],
+                         ids=["uint8 as lerobot-train asks", "float32", "an episode subset"])
+def test_cached_samples_are_lerobots_decoded_samples_without_decoding(dataset_root, monkeypatch, return_uint8,
+                                                                        episodes):
     from lerobot.datasets import dataset_reader
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     from lerobot_tavis.dataset_tools.cached_dataset import FrameCachedDataset
 
     decoded = LeRobotDataset("local/tiny", root=dataset_root, video_backend="pyav", delta_timestamps=DELTA_TIMESTAMPS,
-                             return_uint8=return_uint8)
+                             return_uint8=return_uint8, episodes=episodes)
     expected = [decoded[index] for index in range(len(decoded))]  # LeRobot's decoder's frames
-    assert decoded.num_episodes == 2
+    assert decoded.num_episodes == len(episodes or [0, 1])
     assert any(sample["observation.images.head_is_pad"].any() for sample in expected)
     assert expected[0]["observation.images.head"].dtype == (torch.uint8 if return_uint8 else torch.float32)
 
@@ -118,7 +120,7 @@ def test_cached_samples_are_lerobots_decoded_samples_without_decoding(dataset_ro
 
     monkeypatch.setattr(dataset_reader, "decode_video_frames", no_decoding)
     cached = FrameCachedDataset("local/tiny", root=dataset_root, video_backend="pyav",
-                                delta_timestamps=DELTA_TIMESTAMPS, return_uint8=return_uint8)
+                                delta_timestamps=DELTA_TIMESTAMPS, return_uint8=return_uint8, episodes=episodes)
     assert len(cached) == len(expected)
     cached[0]  # its memory maps are open now; the DataLoader pickles the dataset for its spawned workers, which
     in_worker = pickle.loads(pickle.dumps(cached))  # open them again
