@@ -153,13 +153,15 @@ def test_a_diffusion_preset_trains_evaluates_and_its_checkpoint_runs_in_lerobot_
 
 @pytest.mark.parametrize(("name", "policy_type", "options"), [
     ("act_head_wrist_compact", "act", {}),
-    ("act_hand_relative_head_wrist_compact", "act_hand_relative", {"backbone_norm": "group_norm"})])
+    ("act_hand_relative_head_wrist_compact", "act_hand_relative", {"backbone_norm": "group_norm",
+                                                                   "prompt_input": True})])
 def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, name,
                                                                              policy_type, options, monkeypatch):
     """benchmarks/train_baseline.sh's STATE_INPUT=off: the compact preset's inputs less observation.state; the
     hand-frame preset, whose policy type this package registers (a lerobot-train process of its own finds it through
     the plugin in tests/dataset_tools/test_frame_cache.py), with its time input (a feature no dataset holds; the
-    policy without it trains and acts in tests/policies) and its ResNet group-normalised from the command line."""
+    policy without it trains and acts in tests/policies), its ResNet group-normalised and the prompt input (the
+    dataset's `task` in training, the env's `task_description` when acting) from the command line."""
     preset = json.loads(preset_path(name).read_text())
     preset["policy"]["input_features"].pop("observation.state", None)
     for feature in preset["policy"]["input_features"].values():
@@ -170,7 +172,8 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
         f"--dataset.root={dataset_root}", "--env.task=conditional_pick", "--policy.device=cpu",
         "--policy.dim_model=32", "--policy.dim_feedforward=64", "--policy.n_heads=2", "--steps=2", "--save_freq=2",
         "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}",
-        *(f"--policy.{key}={value}" for key, value in options.items()))
+        *(f"--policy.{key}={str(value).lower() if isinstance(value, bool) else value}"  # draccus: true, not True
+          for key, value in options.items()))
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
     assert config["type"] == policy_type and "observation.state" not in config["input_features"]
@@ -181,8 +184,8 @@ def test_a_compact_act_without_the_state_input_trains_and_tavis_eval_runs_it(dat
 
 def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_root, tmp_path, monkeypatch):
     """`diffusion_hand_relative`, registered by this package (found by lerobot-train as the hand-frame ACT is), with its
-    time input (a feature no dataset holds): a few steps on the tiny dataset (its cameras at their size, one shared
-    image encoder), then one short episode."""
+    time input (a feature no dataset holds) and the prompt input: a few steps on the tiny dataset (its cameras at
+    their size, one shared image encoder), then one short episode."""
     preset = json.loads(preset_path("diffusion_hand_relative_head_wrist_compact").read_text())
     for feature in preset["policy"]["input_features"].values():
         if feature["type"] == "VISUAL":
@@ -191,10 +194,13 @@ def test_a_hand_frame_diffusion_preset_trains_and_tavis_eval_runs_it(dataset_roo
     _lerobot_train_in_this_process(
         monkeypatch, f"--config_path={tmp_path / 'preset.json'}", "--dataset.repo_id=local/tiny",
         f"--dataset.root={dataset_root}", *SMALL_RUN, "--policy.use_separate_rgb_encoder_per_camera=false",
-        "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0", f"--output_dir={tmp_path / 'train'}")
+        "--policy.prompt_input=true", "--steps=2", "--save_freq=2", "--batch_size=2", "--num_workers=0",
+        f"--output_dir={tmp_path / 'train'}")
     checkpoint = tmp_path / "train" / "checkpoints" / "last" / "pretrained_model"
     config = json.loads((checkpoint / "config.json").read_text())
     assert (config["type"], config["time_input"], config["state_input"]) == ("diffusion_hand_relative", True, "none")
+    assert config["prompt_input"] and config["input_features"]["observation.environment_state"]["shape"] == [
+        1 + len(config["prompts"])]
     _one_short_episode(checkpoint, tmp_path / "eval")
 
 

@@ -1,6 +1,7 @@
 """What every hand-frame policy variant (`act_hand_relative`, `diffusion_hand_relative`) shares: its config options
-(time input, AMP precision) and, on the policy, the statistics buffers and the conversion of action chunks between
-the absolute actions LeRobot's processors normalise and the hand-frame ones the network learns and predicts.
+(time and prompt inputs, AMP precision) and, on the policy, the statistics buffers, those inputs and the conversion
+of action chunks between the absolute actions LeRobot's processors normalise and the hand-frame ones the network
+learns and predicts.
 
 Around a LeRobot policy's own network: a training chunk of normalised absolute actions is un-normalised with the
 dataset's action statistics, rewritten in the hand frame of the chunk's anchor state (`hand_frame`) and normalised
@@ -14,7 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from contextlib import nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import torch
@@ -24,6 +25,8 @@ from lerobot.configs.types import FeatureType, NormalizationMode, PolicyFeature
 from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_STATE
 
 from lerobot_tavis import canonical
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_info
+from lerobot_tavis.errors import InputError
 from lerobot_tavis.policies.dataset_fit import check_dataset_images
 from lerobot_tavis.policies.hand_frame import from_hand_frame, to_hand_frame
 from lerobot_tavis.policies.hand_frame_statistics import hand_frame_statistics
@@ -45,6 +48,13 @@ class HandRelativeOptions:
     when acting). It tells apart moments whose images are the same, such as the start of an episode while the
     demonstrator looks at what the policy's cameras do not show.
 
+    `prompt_input`: the episode's prompt as one more network input, a one-hot vector over `prompts` in the same
+    `observation.environment_state` (after the time, with both): the prompt LeRobot hands every sample and every
+    step (`task`: the dataset's and the env's `task_description`). clutter_pick_lift and multi_shelf_scan name the
+    object to lift in their prompt alone, and one policy trained on several tasks tells them apart by it.
+    `prompts` is the vocabulary, saved with the checkpoint: every distinct prompt of the eight TAVIS tasks unless
+    given (clutter_pick_cube and blocked_clutter_pick_cube share theirs). A prompt outside it is refused, naming it.
+
     `amp_dtype`: the precision the network runs in under AMP (`use_amp`, lerobot-train's and lerobot-eval's autocast,
     which is float16 on CUDA): bfloat16 by default, float32's range, because the ResNet starts from random weights
     (no pretrained weights are reachable) and nothing bounds its activations: in float16 they can overflow and turn
@@ -52,6 +62,8 @@ class HandRelativeOptions:
     """
 
     time_input: bool = False
+    prompt_input: bool = False
+    prompts: list[str] = field(default_factory=list)
     fps: float = 20.0  # policy steps per second when acting (TAVIS's rate, envs.physics.POLICY_HZ); training sets
     # the dataset's
     amp_dtype: str = "bfloat16"
@@ -67,17 +79,30 @@ class HandRelativeOptions:
         check_dataset_images(self.input_features, dataset_features,
                              resizes=getattr(self, "resize_shape", None) is not None)
 
-    def _add_time_input(self) -> None:
-        """Before the LeRobot config's own `validate_features`: the time input joins `input_features`."""
+    def _add_env_state_input(self) -> None:
+        """Before the LeRobot config's own `validate_features`: the time and prompt inputs join `input_features` as
+        one `observation.environment_state` vector."""
         self._check_amp_dtype()  # again: `tavis eval --policy-option` sets fields after construction
-        if self.time_input:
-            self.input_features.setdefault(OBS_ENV_STATE, PolicyFeature(FeatureType.ENV, (1,)))
+        if self.prompt_input and not self.prompts:
+            every_prompt = (prompt for task in BENCHMARK_TASKS for prompt in task_info(task).prompts)
+            self.prompts = list(dict.fromkeys(every_prompt))  # in catalog order, each once
+        if size := self.env_state_size():
+            self.input_features.setdefault(OBS_ENV_STATE, PolicyFeature(FeatureType.ENV, (size,)))
+
+    def env_state_size(self) -> int:
+        """Values of `observation.environment_state`: 1 for the time input, one per prompt for the prompt input."""
+        return int(self.time_input) + (len(self.prompts) if self.prompt_input else 0)
 
     def _check_hand_relative_features(self) -> None:
-        time = self.input_features.get(OBS_ENV_STATE)
-        if time is not None and not (self.time_input and tuple(time.shape) == (1,)):
-            raise ValueError(f"{self.type}'s {OBS_ENV_STATE} is its time input, one value (shape (1,)) with "
-                             f"time_input=true; got shape {tuple(time.shape)} with time_input={self.time_input}")
+        env_state = self.input_features.get(OBS_ENV_STATE)
+        size = self.env_state_size()
+        if (env_state is None and size) or (env_state is not None and tuple(env_state.shape) != (size,)):
+            raise ValueError(f"{self.type}'s {OBS_ENV_STATE} holds its time input (1 value, time_input="
+                             f"{self.time_input}) and prompt input ({len(self.prompts)} values, prompt_input="
+                             f"{self.prompt_input}): shape ({size},) expected, got "
+                             f"{None if env_state is None else tuple(env_state.shape)}")
+        if len(set(self.prompts)) != len(self.prompts):
+            raise ValueError(f"{self.type}'s prompts must be distinct")
         action = self.output_features.get(ACTION)
         if action is None or tuple(action.shape) != (canonical.ACTION_DIM,):
             raise ValueError(f"{self.type} needs TAVIS's {canonical.ACTION_DIM}-D canonical {ACTION}, got "
@@ -177,6 +202,28 @@ class HandRelativeChunks:
     def _elapsed_time(self, batch_size: int, like: Tensor) -> Tensor:
         """The time input (B, 1) when acting: the steps `select_action` has taken since `reset()` over `config.fps`."""
         return self._time_token(torch.full((batch_size,), self._elapsed_steps / self.config.fps), like)
+
+    def _env_state(self, time: Tensor | None, prompts: list[str] | None, like: Tensor,
+                   steps: int | None = None) -> Tensor:
+        """`observation.environment_state`, (B, E), or (B, steps, E) for Diffusion Policy's observation steps: the
+        time input (B, 1) or (B, steps, 1) as given (None without it), then the prompt input, one-hot over
+        `config.prompts`, the same at every step."""
+        parts = [] if time is None else [time]
+        if self.config.prompt_input:
+            if prompts is None:
+                raise InputError(f"{self.name} reads the episode's prompt (prompt_input): the batch holds no `task`")
+            unknown = sorted(set(prompts) - set(self._prompt_rows))
+            if unknown:
+                raise InputError(f"{self.name} was trained on {len(self.config.prompts)} prompts; {unknown[0]!r} is "
+                                 "not one of them")
+            rows = torch.tensor([self._prompt_rows[prompt] for prompt in prompts], device=like.device)
+            one_hot = torch.nn.functional.one_hot(rows, len(self.config.prompts)).to(torch.float32)
+            parts.append(one_hot if steps is None else one_hot.unsqueeze(1).expand(-1, steps, -1))
+        return torch.cat(parts, dim=-1)
+
+    @property
+    def _prompt_rows(self) -> dict[str, int]:
+        return {prompt: row for row, prompt in enumerate(self.config.prompts)}
 
     @staticmethod
     def _time_token(elapsed_s: Tensor, like: Tensor) -> Tensor:

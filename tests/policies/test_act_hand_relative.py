@@ -12,7 +12,9 @@ from lerobot.policies.act.modeling_act import ACTPolicy
 from lerobot.utils.constants import ACTION, OBS_ENV_STATE, OBS_STATE
 
 from lerobot_tavis import canonical
+from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS, task_info
 from lerobot_tavis.envs.transforms import matrix_from_quat, quat_multiply
+from lerobot_tavis.errors import InputError
 from lerobot_tavis.policies import register_policy_types
 from lerobot_tavis.policies.act_hand_relative.configuration_act_hand_relative import ACTHandRelativeConfig
 from lerobot_tavis.policies.act_hand_relative.modeling_act_hand_relative import ACTHandRelativePolicy
@@ -232,11 +234,40 @@ def test_the_time_input_is_the_timestamp_in_training_and_the_steps_since_reset_w
     assert [float(planned[OBS_ENV_STATE]) * 10.0 for planned in seen] == pytest.approx([0.0, 0.2, 0.4, 0.0])
 
 
-@pytest.mark.parametrize(("time_input", "shape"), [(False, (1,)), (True, (2,))])
-def test_an_environment_state_other_than_the_time_input_is_refused(time_input, shape):
-    with pytest.raises(ValueError, match="observation.environment_state is its time input"):
-        ACTHandRelativePolicy(_config(time_input=time_input,
-                                      inputs={OBS_ENV_STATE: PolicyFeature(FeatureType.ENV, shape)}))
+def test_the_prompt_input_is_a_one_hot_of_the_episodes_prompt_after_the_time(dataset_root, monkeypatch):
+    """The vocabulary defaults to every prompt of the eight tasks (clutter_pick_lift's name the object to lift);
+    the network reads which one the batch's `task` is, in training and when acting."""
+    root, episodes = dataset_root
+    torch.manual_seed(0)
+    policy = ACTHandRelativePolicy(_config(time_input=True, prompt_input=True), dataset_stats=_action_stats(episodes),
+                                   dataset_meta=SimpleNamespace(root=root, fps=10))
+    prompts = list(dict.fromkeys(prompt for task in BENCHMARK_TASKS for prompt in task_info(task).prompts))
+    assert policy.config.prompts == prompts and len(prompts) > len(BENCHMARK_TASKS)
+    assert policy.config.input_features[OBS_ENV_STATE] == PolicyFeature(FeatureType.ENV, (1 + len(prompts),))
+    soup, tuna = task_info("clutter_pick_lift").prompts[0], task_info("clutter_pick_lift").prompts[6]
+    batch, _ = _batch(np.random.default_rng(4), policy, 2)
+    observation = {IMAGE: batch[IMAGE][:1].expand(2, -1, -1, -1), OBS_STATE: batch[OBS_STATE][:1].expand(2, -1)}
+    policy.reset()
+    chunks = policy.predict_action_chunk({**observation, "task": [soup, tuna]})
+    assert not torch.allclose(chunks[0], chunks[1])  # the same images, two prompts: the network reads the prompt
+
+    seen = []
+    monkeypatch.setattr(ACTPolicy, "forward", lambda self, batch: seen.append(batch) or (torch.zeros(()), {}))
+    policy.forward({**batch, "timestamp": torch.tensor([0.0, 1.5]), "task": [tuna, soup]})
+    expected = torch.zeros(2, 1 + len(prompts))
+    expected[:, 0] = torch.tensor([0.0, 0.15])
+    expected[0, 1 + prompts.index(tuna)] = expected[1, 1 + prompts.index(soup)] = 1.0
+    torch.testing.assert_close(seen[-1][OBS_ENV_STATE], expected)
+    with pytest.raises(InputError, match="trained on .* prompts; 'Lift the spoon.' is not one of them"):
+        policy.predict_action_chunk({**observation, "task": [soup, "Lift the spoon."]})
+
+
+@pytest.mark.parametrize(("fields", "shape"), [
+    ({"time_input": False}, (1,)), ({"time_input": True}, (2,)),
+    ({"time_input": True, "prompt_input": True, "prompts": ["a", "b"]}, (2,))])
+def test_an_environment_state_other_than_the_time_and_prompt_inputs_is_refused(fields, shape):
+    with pytest.raises(ValueError, match="observation.environment_state holds its time input"):
+        ACTHandRelativePolicy(_config(**fields, inputs={OBS_ENV_STATE: PolicyFeature(FeatureType.ENV, shape)}))
 
 
 def test_the_state_as_a_network_input_or_another_action_is_refused():

@@ -140,6 +140,24 @@ def test_the_time_input_is_each_observations_time_in_training_and_counted_steps_
                                torch.tensor([[0.0, 0.0], [0.015, 0.02]]))
 
 
+def test_the_prompt_input_follows_the_time_at_every_observation_step(dataset_root, monkeypatch):
+    policy = _policy(dataset_root, time_input=True, prompt_input=True, prompts=["Lift the can.", "Lift the box."])
+    assert policy.config.input_features[OBS_ENV_STATE] == PolicyFeature(FeatureType.ENV, (3,))
+    batch, _ = _batch(policy, size=2)
+    seen = []
+    monkeypatch.setattr(DiffusionModel, "compute_loss", lambda self, batch: seen.append(batch) or torch.zeros(()))
+    policy.forward({**batch, "timestamp": torch.tensor([0.0, 1.5]), "task": ["Lift the box.", "Lift the can."]})
+    torch.testing.assert_close(seen[-1][OBS_ENV_STATE], torch.tensor([[[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]],
+                                                                      [[0.145, 1.0, 0.0], [0.15, 1.0, 0.0]]]))
+    monkeypatch.setattr(DiffusionModel, "generate_actions",
+                        lambda self, batch, noise=None: seen.append(batch) or torch.zeros(1, EXECUTED, 19))
+    seen.clear()
+    policy.reset()
+    policy.select_action({IMAGE: torch.rand(1, 3, 16, 16), OBS_STATE: batch[OBS_STATE][:1, -1],
+                          "task": ["Lift the box."]})
+    torch.testing.assert_close(seen[-1][OBS_ENV_STATE], torch.tensor([[[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]]))
+
+
 def test_under_amp_the_network_runs_in_bfloat16_whatever_autocast_asked(dataset_root):
     policy = _policy(dataset_root)
     seen = []

@@ -1,4 +1,5 @@
-"""Configuration of `act_hand_relative`: ACT's, with requirements on its features and an optional time input."""
+"""Configuration of `act_hand_relative`: ACT's, with requirements on its features and optional time and prompt
+inputs."""
 
 from __future__ import annotations
 
@@ -19,7 +20,8 @@ GROUP_NORM_CHANNELS = 16  # channels per group of "group_norm" (Diffusion Policy
 class ACTHandRelativeConfig(HandRelativeOptions, ACTConfig):
     """ACT that predicts each chunk's arm poses relative to the hand pose measured when the chunk is planned.
 
-    The network sees the cameras alone (and the time, with `time_input`: `HandRelativeOptions`):
+    The network sees the cameras alone (and the time and the prompt, with `time_input` and `prompt_input`:
+    `HandRelativeOptions`):
     `observation.state` is read only as the anchor, so it must not be among `input_features` (the processors then
     pass it through un-normalised). The action is TAVIS's canonical 19-D vector. Every ACT option keeps its meaning,
     temporal ensembling included (chunks are turned back into absolute actions before they are queued or
@@ -37,7 +39,7 @@ class ACTHandRelativeConfig(HandRelativeOptions, ACTConfig):
 
     def validate_features(self) -> None:
         self._check_backbone_norm()  # again: `tavis eval --policy-option` sets fields after construction
-        self._add_time_input()
+        self._add_env_state_input()
         super().validate_features()
         if OBS_STATE in self.input_features:
             raise ValueError(f"act_hand_relative reads {OBS_STATE} only to anchor its chunks and does not feed it to "

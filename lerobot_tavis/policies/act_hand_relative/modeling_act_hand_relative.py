@@ -34,10 +34,11 @@ class ACTHandRelativePolicy(HandRelativeChunks, ACTPolicy):
 
     def forward(self, batch: dict[str, Tensor]) -> tuple[Tensor, dict]:
         """ACT's loss on the chunk (normalised absolute actions in `batch`, state (B, 19) raw) rewritten in the hand
-        frame of the state."""
+        frame of the state; with the time and prompt inputs, from `batch["timestamp"]` (B,) and `batch["task"]`."""
         batch = {**batch, ACTION: self._to_network_chunk(batch[ACTION], batch[OBS_STATE])}
-        if self.config.time_input:
-            batch[OBS_ENV_STATE] = self._time_token(batch["timestamp"], batch[ACTION])
+        if self.config.env_state_size():
+            time = self._time_token(batch["timestamp"], batch[ACTION]) if self.config.time_input else None
+            batch[OBS_ENV_STATE] = self._env_state(time, batch.get("task"), batch[ACTION])
         with self._amp_precision(batch[ACTION].device):
             return super().forward(batch)
 
@@ -52,8 +53,9 @@ class ACTHandRelativePolicy(HandRelativeChunks, ACTPolicy):
         """A chunk of normalised absolute actions (B, chunk_size, 19), anchored on `batch`'s raw state (B, 19)."""
         self._check_statistics()
         state = batch[OBS_STATE]
-        if self.config.time_input:
-            batch = {**batch, OBS_ENV_STATE: self._elapsed_time(state.shape[0], state)}
+        if self.config.env_state_size():
+            time = self._elapsed_time(state.shape[0], state) if self.config.time_input else None
+            batch = {**batch, OBS_ENV_STATE: self._env_state(time, batch.get("task"), state)}
         with self._amp_precision(state.device):
             relative = super().predict_action_chunk(batch)
         return self._from_network_chunk(relative, state)

@@ -1,5 +1,5 @@
 """Configuration of `diffusion_hand_relative`: Diffusion Policy's, with the state left raw by the processors, a
-choice of what the network sees of it, and an optional time input."""
+choice of what the network sees of it, and optional time and prompt inputs."""
 
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ class DiffusionHandRelativeConfig(HandRelativeOptions, DiffusionConfig):
 
     Actions are normalised with min and max (to [-1, 1], which `clip_sample` keeps denoised samples in), the
     hand-frame ones with the min and max of every training horizon's actions in their anchor's frame.
-    `time_input`, `fps`, `amp_dtype`: `HandRelativeOptions`.
+    `time_input`, `prompt_input`, `prompts`, `fps`, `amp_dtype`: `HandRelativeOptions`.
     """
 
     state_input: str = "none"
@@ -52,7 +52,7 @@ class DiffusionHandRelativeConfig(HandRelativeOptions, DiffusionConfig):
         self._check_state_input()
 
     def validate_features(self) -> None:
-        self._add_time_input()
+        self._add_env_state_input()
         self._check_state_input()  # again: `tavis eval --policy-option` sets fields after construction
         super().validate_features()
         state = self.input_features.get(OBS_STATE)

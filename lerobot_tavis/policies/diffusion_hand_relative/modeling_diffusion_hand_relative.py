@@ -58,8 +58,9 @@ class DiffusionHandRelativePolicy(HandRelativeChunks, DiffusionPolicy):
         """One step's observation (raw state (B, 19)) -> a normalised absolute action (B, 19)."""
         state = batch[OBS_STATE]
         batch = {**batch, ANCHOR: state, OBS_STATE: self._network_state(state)}
-        if self.config.time_input:
-            batch[OBS_ENV_STATE] = self._elapsed_time(state.shape[0], state)
+        if self.config.env_state_size():
+            time = self._elapsed_time(state.shape[0], state) if self.config.time_input else None
+            batch[OBS_ENV_STATE] = self._env_state(time, batch.get("task"), state)
         action = super().select_action(batch, noise=noise)
         self._elapsed_steps += 1
         return action
@@ -82,13 +83,17 @@ class DiffusionHandRelativePolicy(HandRelativeChunks, DiffusionPolicy):
     def _network_observations(self, batch: dict[str, Tensor]) -> dict[str, Tensor]:
         """A dataset batch's observations as the network reads them: the state by `config.state_input` and, with
         the time input, each observation's seconds since the episode began, from the current step's `timestamp`
-        back by 1/fps a step and held at 0 before the episode (where LeRobot repeats its first frame)."""
+        back by 1/fps a step and held at 0 before the episode (where LeRobot repeats its first frame), and with the
+        prompt input the one-hot of `batch["task"]` at every step."""
         state = batch[OBS_STATE]
         batch = {**batch, OBS_STATE: self._network_state(state)}
-        if self.config.time_input:
-            steps_back = torch.arange(self.config.n_obs_steps - 1, -1, -1, device=state.device)
-            elapsed_s = batch["timestamp"].to(state.device).unsqueeze(-1) - steps_back / self.config.fps
-            batch[OBS_ENV_STATE] = self._time_token(elapsed_s.clamp_min(0.0), state)
+        if self.config.env_state_size():
+            time = None
+            if self.config.time_input:
+                steps_back = torch.arange(self.config.n_obs_steps - 1, -1, -1, device=state.device)
+                elapsed_s = batch["timestamp"].to(state.device).unsqueeze(-1) - steps_back / self.config.fps
+                time = self._time_token(elapsed_s.clamp_min(0.0), state)
+            batch[OBS_ENV_STATE] = self._env_state(time, batch.get("task"), state, steps=self.config.n_obs_steps)
         return batch
 
     def _network_state(self, state: Tensor) -> Tensor:
