@@ -10,10 +10,12 @@
 #                                             and the table into the README.md there (docs/results/README.md),
 #                                             `tavis ablation` each robot's ablation_<robot>.md beside them
 #
-# One recipe for every cell: the `act_hand_relative_<condition>_compact` presets (their files' SHA-256 are part of the
+# One recipe per suite: the `act_hand_relative_<condition>_compact` presets (their files' SHA-256 are part of the
 # recipe, so an edited preset is another recipe), EPISODES (160) demonstrations, STEPS (3200) steps of BATCH (128),
 # training seed SEED (1000), the last checkpoint evaluated on EVAL_EPISODES (96) episodes from seed 1000 of the id
-# split, head_wrist also on ood_spatial and ood_init_pose. Training and evaluation are benchmarks/train_baseline.sh's
+# split, head_wrist also on ood_spatial and ood_init_pose; TAVIS-Head's policies also take the suite's policy
+# options (SUITE_OPTIONS below: the prompt input, which clutter_pick_lift and multi_shelf_scan need, and a
+# group-normalised ResNet). Training and evaluation are benchmarks/train_baseline.sh's
 # (`pair`, or `cell` when one condition is left), one recording per (robot, task).
 # A finished condition becomes RESULTS/<robot>/<task>/<condition>/: the `tavis eval` output without videos, the
 # training config (train_config.json), the run's log (log.txt, each progress bar's last state), the model card
@@ -51,11 +53,15 @@ export FRAME_CACHE=on
 CONDITIONS=(head_wrist fixed_wrist)
 cd "$ROOT"
 
-# Prints the recipe (JSON: what every cell of one table shares); with a recipe.json as argument, compares instead
-# and fails with a message when that file records another recipe; with `write FILE COMMAND`, writes a recipe.json.
+# `python3 -c "$RECIPE" TASK` prints the recipe of TASK's suite (JSON: what every cell of the suite shares); with
+# `options`, the lerobot-train arguments of its policy options; with a recipe.json, compares instead and fails with a
+# message when that file records another recipe; with `write FILE COMMAND`, writes a recipe.json.
 RECIPE='import hashlib, json, os, platform, subprocess, sys
+from lerobot_tavis.envs.tasks.catalog import task_info
 from lerobot_tavis.policy_configs import preset_path
+SUITE_OPTIONS = {"tavis_head": {"backbone_norm": "group_norm", "prompt_input": True}}
 env = os.environ
+task, sys.argv = sys.argv[1], sys.argv[1:]
 presets = {condition: hashlib.sha256(preset_path(f"act_hand_relative_{condition}_compact").read_bytes()).hexdigest()
            for condition in ("head_wrist", "fixed_wrist")}
 recipe = {"presets": "act_hand_relative_<condition>_compact", "preset_sha256": presets,
@@ -63,8 +69,14 @@ recipe = {"presets": "act_hand_relative_<condition>_compact", "preset_sha256": p
           "training_seed": int(env["SEED"]), "image_size": "120x160", "device": env["DEVICE"],
           "evaluation": {"episodes": int(env["EVAL_EPISODES"]), "first_seed": 1000, "checkpoint": "last",
                          "splits": {"head_wrist": ["id", "ood_spatial", "ood_init_pose"], "fixed_wrist": ["id"]}}}
+options = SUITE_OPTIONS.get(task_info(task).suite)
+if options:
+    recipe["policy_options"] = options
 if len(sys.argv) == 1:
     print(json.dumps(recipe, indent=2))
+elif sys.argv[1] == "options":
+    print(*(f"--policy.{key}={str(value).lower() if isinstance(value, bool) else value}"
+            for key, value in (options or {}).items()))
 elif sys.argv[1] == "write":
     def output(*command):
         try:
@@ -100,7 +112,7 @@ complete() {  # complete ROBOT TASK CONDITION: its folder is there (and holds th
   local folder
   folder=$(cell_dir "$@")
   [ -d "$folder" ] || return 1
-  python3 -c "$RECIPE" "$folder/recipe.json" || exit 2
+  python3 -c "$RECIPE" "$2" "$folder/recipe.json" || exit 2
 }
 
 add_entry() {  # add_entry ROBOT TASK CONDITION: its line in BASELINES (again, if a killed run left it out)
@@ -128,7 +140,7 @@ publish() {  # publish ROBOT TASK CONDITION: the evaluation of the last checkpoi
   tavis push-policy "$checkpoint/pretrained_model" --repo-id "$HUB_OWNER/act_hand_relative_$1_$2_$3" \
     --results "$stage/results.json" --out "$work/model_$3" > /dev/null
   cp "$work/model_$3/README.md" "$stage/model_card.md"
-  python3 -c "$RECIPE" write "$stage/recipe.json" "benchmarks/baselines.sh cell $1 $2"
+  python3 -c "$RECIPE" "$2" write "$stage/recipe.json" "benchmarks/baselines.sh cell $1 $2"
   mv -T "$stage" "$final"
   add_entry "$@"
   echo "baselines: $1 $2 $3 done: $final"
@@ -142,9 +154,9 @@ trained() {  # trained ROBOT TASK CONDITION: WORK holds the checkpoint of its tr
 
 scratch() {  # scratch ROBOT TASK: WORK's folder of the cell, emptied if another recipe made it, with this recipe.json
   local work="$WORK/$1_$2"
-  if ! python3 -c "$RECIPE" "$work/recipe.json" 2> /dev/null; then rm -rf "$work"; fi
+  if ! python3 -c "$RECIPE" "$2" "$work/recipe.json" 2> /dev/null; then rm -rf "$work"; fi
   mkdir -p "$work"
-  python3 -c "$RECIPE" write "$work/recipe.json" "benchmarks/baselines.sh cell $1 $2"
+  python3 -c "$RECIPE" "$2" write "$work/recipe.json" "benchmarks/baselines.sh cell $1 $2"
 }
 
 prepare() {  # prepare ROBOT TASK: the recording, datasets and frame caches of its unfinished conditions, at a low
@@ -176,7 +188,7 @@ cell() {  # cell ROBOT TASK
   done
   echo "baselines: $robot $task: ${todo[*]}; training ${train[*]:-none} (logs: $work/cell_<condition>.log)"
   ( export ROBOT=$robot TASK=$task WORK=$work WORKERS ACTIONS=hand_relative SAVE_FREQ=$STEPS CHECKPOINTS=last \
-      SPLITS=table
+      SPLITS=table TRAIN_OPTIONS="$(python3 -c "$RECIPE" "$task" options)"
     if (( ${#train[@]} == 2 )); then
       "$HERE/train_baseline.sh" pair  # one recording for both, each on a GPU of its own
     else  # each condition on a GPU of its own: trained and evaluated (`cell`), or evaluated (`eval`)
@@ -225,15 +237,15 @@ check_cell() {  # check_cell ROBOT TASK: both known, else exit 2
 case "${1:-}" in
   cell)
     if (( $# != 3 )); then echo "usage: $0 cell ROBOT TASK" >&2; exit 2; fi
-    python3 -c "$RECIPE" > /dev/null  # a setting that is no number stops here
     check_cell "$2" "$3"
+    python3 -c "$RECIPE" "$3" > /dev/null  # a setting that is no number stops here
     status=0
     cell "$2" "$3" || status=$?
     write_table
     exit "$status"
     ;;
   table)
-    python3 -c "$RECIPE" > /dev/null
+    python3 -c "$RECIPE" conditional_pick > /dev/null
     ROBOTS=${ROBOTS:-gr1t2 reachy2}
     TASKS=${TASKS:-$(python3 -c "from lerobot_tavis.envs.tasks.catalog import BENCHMARK_TASKS as t; print(*t)")}
     cells=()

@@ -1,7 +1,8 @@
 """benchmarks/baselines.sh, the table's one command, run with stand-ins for the GPU work (recording, training,
 evaluation, the model card) that record how they were called; `tavis table-add` is the real one. What is checked:
 a cell's folders and baselines.json entries, the skip on a second run, the refusal of another recipe, a lost
-condition trained again alone, two (robot, task) cells at once on four GPUs, and a failed training left out."""
+condition trained again alone, two (robot, task) cells at once on four GPUs, each suite's recipe, and a failed
+training left out."""
 
 import json
 import os
@@ -92,6 +93,7 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
     for train in _calls(tmp_path, "lerobot-train"):  # the recipe, whatever TRAIN_OPTIONS the environment held
         assert " --steps=20 --save_freq=20 --batch_size=128" in train and "--steps=1 " not in train
         assert "--seed=1000 " in train and "--env.robot=gr1t2 " in train
+        assert "--policy.backbone_norm=group_norm --policy.prompt_input=true" in train  # TAVIS-Head's options
     assert "| TAVIS-Head | clutter_pick_cube | 50.0% [" in (tmp_path / "baselines.md").read_text()  # the table too
     ablation = (tmp_path / "ablation_gr1t2.md").read_text()  # and each robot's ablation, as far as it goes
     assert "| clutter_pick_cube | fixed_wrist | 50.0% [" in ablation
@@ -118,6 +120,7 @@ def test_a_cell_trains_both_conditions_once_publishes_them_and_a_second_run_skip
         assert card == f"card of tavis/act_hand_relative_gr1t2_clutter_pick_cube_{mode}\n"
         recorded = json.loads((folder / "recipe.json").read_text())
         assert recorded["recipe"]["steps"] == 20
+        assert recorded["recipe"]["policy_options"] == {"backbone_norm": "group_norm", "prompt_input": True}
         assert recorded["command"] == "benchmarks/baselines.sh cell gr1t2 clutter_pick_cube"
     assert not list((tmp_path / "results" / "gr1t2" / "clutter_pick_cube").glob(".*"))
 
@@ -174,6 +177,10 @@ def test_the_table_runs_two_cells_at_once_on_four_gpus_and_leaves_a_failed_train
                       ("conditional_pick", "head_wrist", "gpu=0 egl=0"),
                       ("peeking_box", "fixed_wrist", "gpu=1 egl=1"),
                       ("peeking_box", "head_wrist", "gpu=0 egl=0")]
+    for train in _calls(tmp_path, "lerobot-train"):  # one recipe per suite: TAVIS-Hands' has no policy options
+        assert ("--policy.prompt_input=true" in train) is ("--env.task=peeking_box" not in train)
+    hands = json.loads((tmp_path / "results" / "gr1t2" / "peeking_box" / "head_wrist" / "recipe.json").read_text())
+    assert "policy_options" not in hands["recipe"]
     # peeking_box, the first pair's second cell, was recorded, converted and cached while conditional_pick trained;
     # its own run kept those datasets: one recording per cell, one conversion per condition.
     assert (tmp_path / "work" / "prepare_gr1t2_peeking_box.log").is_file()
