@@ -203,6 +203,12 @@ class HandRelativeChunks:
         """The time input (B, 1) when acting: the steps `select_action` has taken since `reset()` over `config.fps`."""
         return self._time_token(torch.full((batch_size,), self._elapsed_steps / self.config.fps), like)
 
+    def _acting_env_state(self, batch: dict, state: Tensor) -> Tensor:
+        """`observation.environment_state` (B, E) when acting on `batch`, whose raw state is `state` (B, 19): the
+        steps since `reset()` and the batch's prompts (`task`), as the config asks."""
+        time = self._elapsed_time(state.shape[0], state) if self.config.time_input else None
+        return self._env_state(time, batch.get("task"), state)
+
     def _env_state(self, time: Tensor | None, prompts: list[str] | None, like: Tensor,
                    steps: int | None = None) -> Tensor:
         """`observation.environment_state`, (B, E), or (B, steps, E) for Diffusion Policy's observation steps: the

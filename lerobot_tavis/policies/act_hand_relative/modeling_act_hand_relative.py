@@ -54,8 +54,7 @@ class ACTHandRelativePolicy(HandRelativeChunks, ACTPolicy):
         self._check_statistics()
         state = batch[OBS_STATE]
         if self.config.env_state_size():
-            time = self._elapsed_time(state.shape[0], state) if self.config.time_input else None
-            batch = {**batch, OBS_ENV_STATE: self._env_state(time, batch.get("task"), state)}
+            batch = {**batch, OBS_ENV_STATE: self._acting_env_state(batch, state)}
         with self._amp_precision(state.device):
             relative = super().predict_action_chunk(batch)
         return self._from_network_chunk(relative, state)

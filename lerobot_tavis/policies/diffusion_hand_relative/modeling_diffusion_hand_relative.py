@@ -59,8 +59,7 @@ class DiffusionHandRelativePolicy(HandRelativeChunks, DiffusionPolicy):
         state = batch[OBS_STATE]
         batch = {**batch, ANCHOR: state, OBS_STATE: self._network_state(state)}
         if self.config.env_state_size():
-            time = self._elapsed_time(state.shape[0], state) if self.config.time_input else None
-            batch[OBS_ENV_STATE] = self._env_state(time, batch.get("task"), state)
+            batch[OBS_ENV_STATE] = self._acting_env_state(batch, state)
         action = super().select_action(batch, noise=noise)
         self._elapsed_steps += 1
         return action
