@@ -51,19 +51,30 @@ def dataset(raw_dir, tmp_path_factory):
 @pytest.fixture(scope="module")
 def peeking_box(raw_dir, tmp_path_factory):
     """peeking_box's two episodes, head and left wrist cameras, converted by one worker while LeRobot's video encoder
-    starts late, as on a loaded machine: each episode's frames all queue up before it encodes one."""
-    import time
+    lags, as on a loaded machine, as far as it can: each episode's encoder threads start encoding only once the
+    episode's last frame is queued (when the episode is finished)."""
+    import threading
 
     from lerobot.datasets import video_utils
 
     encode = video_utils._CameraEncoderThread.run
+    finish = video_utils.StreamingVideoEncoder.finish_episode
+    episode_fed = threading.Event()
 
     def lagging(thread):
-        time.sleep(3.0)
+        assert episode_fed.wait(timeout=120), "the episode was never finished"
         encode(thread)
+
+    def finish_fed_episode(encoder):
+        episode_fed.set()
+        try:
+            return finish(encoder)  # waits for the episode's encoder threads
+        finally:
+            episode_fed.clear()
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(video_utils._CameraEncoderThread, "run", lagging)
+        patch.setattr(video_utils.StreamingVideoEncoder, "finish_episode", finish_fed_episode)
         return convert(ConvertConfig(raw_dir, "local/peeking_box", tmp_path_factory.mktemp("lagged") / "peeking_box",
                                      image_size=SMALL, task="peeking_box", cameras=TWO_CAMERAS), progress=False)
 
