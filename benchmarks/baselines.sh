@@ -61,7 +61,7 @@ from lerobot_tavis.envs.tasks.catalog import task_info
 from lerobot_tavis.policy_configs import preset_path
 SUITE_OPTIONS = {"tavis_head": {"backbone_norm": "group_norm", "prompt_input": True}}
 env = os.environ
-task, sys.argv = sys.argv[1], sys.argv[1:]
+task, *args = sys.argv[1:]
 presets = {condition: hashlib.sha256(preset_path(f"act_hand_relative_{condition}_compact").read_bytes()).hexdigest()
            for condition in ("head_wrist", "fixed_wrist")}
 recipe = {"presets": "act_hand_relative_<condition>_compact", "preset_sha256": presets,
@@ -72,12 +72,12 @@ recipe = {"presets": "act_hand_relative_<condition>_compact", "preset_sha256": p
 options = SUITE_OPTIONS.get(task_info(task).suite)
 if options:
     recipe["policy_options"] = options
-if len(sys.argv) == 1:
+if not args:
     print(json.dumps(recipe, indent=2))
-elif sys.argv[1] == "options":
+elif args[0] == "options":
     print(*(f"--policy.{key}={str(value).lower() if isinstance(value, bool) else value}"
             for key, value in (options or {}).items()))
-elif sys.argv[1] == "write":
+elif args[0] == "write":
     def output(*command):
         try:
             return subprocess.run(command, capture_output=True, text=True, check=True).stdout.strip()
@@ -85,25 +85,25 @@ elif sys.argv[1] == "write":
             return ""
     gpus = output("nvidia-smi", "--query-gpu=name", "--format=csv,noheader").splitlines()
     machine = f"{len(gpus)} x {gpus[0]}, " if gpus else ""
-    record = {"recipe": recipe, "command": sys.argv[3],
+    record = {"recipe": recipe, "command": args[2],
               "commit": env.get("COMMIT") or output("git", "describe", "--always", "--dirty", "--abbrev=12")
               or "not recorded: set COMMIT outside a git checkout",
               "machine": f"{machine}{os.cpu_count()} cores, {platform.node()}",
               "finished_utc": output("date", "-u", "+%Y-%m-%dT%H:%M:%SZ")}
-    with open(sys.argv[2] + ".tmp", "w") as file:
+    with open(args[1] + ".tmp", "w") as file:
         json.dump(record, file, indent=2)
         file.write("\n")
-    os.replace(sys.argv[2] + ".tmp", sys.argv[2])
+    os.replace(args[1] + ".tmp", args[1])
 else:
     try:
-        recorded = json.load(open(sys.argv[1]))["recipe"]
+        recorded = json.load(open(args[0]))["recipe"]
         recorded.items()
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
-        sys.exit(f"baselines: {sys.argv[1]} is missing or damaged: remove its folder to make the cell again")
+        sys.exit(f"baselines: {args[0]} is missing or damaged: remove its folder to make the cell again")
     if recorded != recipe:
         changed = sorted(key for key in {**recipe, **recorded} if recorded.get(key) != recipe.get(key))
         changed = ", ".join(changed)
-        sys.exit(f"baselines: {sys.argv[1]} was made with another recipe ({changed} differ): one table "
+        sys.exit(f"baselines: {args[0]} was made with another recipe ({changed} differ): one table "
                  "holds one recipe; remove that folder to make the cell again with these settings")'
 
 cell_dir() { echo "$RESULTS/$1/$2/$3"; }  # cell_dir ROBOT TASK CONDITION

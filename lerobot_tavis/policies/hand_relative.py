@@ -218,18 +218,15 @@ class HandRelativeChunks:
         if self.config.prompt_input:
             if prompts is None:
                 raise InputError(f"{self.name} reads the episode's prompt (prompt_input): the batch holds no `task`")
-            unknown = sorted(set(prompts) - set(self._prompt_rows))
+            row_of = {prompt: row for row, prompt in enumerate(self.config.prompts)}
+            unknown = sorted(set(prompts) - set(row_of))
             if unknown:
                 raise InputError(f"{self.name} was trained on {len(self.config.prompts)} prompts; {unknown[0]!r} is "
                                  "not one of them")
-            rows = torch.tensor([self._prompt_rows[prompt] for prompt in prompts], device=like.device)
+            rows = torch.tensor([row_of[prompt] for prompt in prompts], device=like.device)
             one_hot = torch.nn.functional.one_hot(rows, len(self.config.prompts)).to(torch.float32)
             parts.append(one_hot if steps is None else one_hot.unsqueeze(1).expand(-1, steps, -1))
         return torch.cat(parts, dim=-1)
-
-    @property
-    def _prompt_rows(self) -> dict[str, int]:
-        return {prompt: row for row, prompt in enumerate(self.config.prompts)}
 
     @staticmethod
     def _time_token(elapsed_s: Tensor, like: Tensor) -> Tensor:
