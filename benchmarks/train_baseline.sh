@@ -5,7 +5,9 @@
 #   benchmarks/train_baseline.sh pair|cell|data|prepare|train|eval|overfit
 #
 # Settings (environment variables): CONDITION (head_wrist: head + both wrist cameras, the paper's "headcam";
-# fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick), ROBOT (gr1t2), EPISODES (160 kept
+# fixed_wrist: fixed + both wrists, its "fixedcam"), TASK (conditional_pick; a comma-separated list, e.g.
+# peeking_box,occluded_reach: one policy trained on all of them, EPISODES each, and evaluated on each; with
+# TRAIN_OPTIONS=--policy.prompt_input=true it reads which task from the prompt), ROBOT (gr1t2), EPISODES (160 kept
 # demonstrations, as many as the reference's datasets hold per task), STEPS, SAVE_FREQ and BATCH (the preset's, 6000,
 # 2000 and 64), SEED (lerobot-train's, 1000 as its default: another seed trains a replicate), WORKERS (recording,
 # conversion and loading processes: all cores), EVAL_EPISODES (96), EVAL_JOBS and EVAL_BATCH (4 and 12: an
@@ -52,7 +54,9 @@
 #   BATCH 128 with SAVE_FREQ 1600 (800) unless set (loaders: WORKERS - 2; the preset anneals the lr to 0 at the last
 #   step; about 13 minutes with 16 cores and an evaluation beside, 10 for hand_relative; TRAIN_S, 960 s, only guards
 #   the slot; POLICY=diffusion, not yet timed on a GPU: 1500 s), the checkpoints evaluated at low CPU priority as
-#   they appear, and those left after training ends side by side.
+#   they appear, and those left after training ends side by side. It fails (exit 1, saying which) when the training
+#   stopped early (a NaN loss, TRAIN_S) or an evaluation failed, after evaluating what the training saved; `pair`
+#   fails when either condition's `cell` does, naming its log.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0), unless WORK already holds
 #   that conversion of that recording (its meta/tavis_conversion.json says so): then the dataset is kept.
@@ -68,7 +72,8 @@
 #   alone: CHECKPOINTS=last; one step's: CHECKPOINTS=1600), seeds from 1000, side by side; it can run beside
 #   `train`, which marks a checkpoint complete by pointing `checkpoints/last` at it, and beside another `eval` call,
 #   which skips the checkpoints that one is evaluating. Then `tavis curve` puts every finished checkpoint's success
-#   and GALT in one table and plot by training step: $WORK/$EVAL_NAME/checkpoints.md and checkpoints.png.
+#   and GALT in one table and plot by training step: $WORK/$EVAL_NAME/checkpoints.md and checkpoints.png; exit 1
+#   when one of its evaluations failed.
 # - overfit: the pipeline sanity check. Trains on 8 demonstrations (seeds 100000-100007) for OVERFIT_STEPS (3000) and
 #   evaluates on those same seeds and on 8 new ones: a policy that cannot do better on the scenes it was trained
 #   on points at a data or alignment bug, not at too little training.
@@ -300,9 +305,10 @@ train() {  # train DATASET_DIR OUTPUT_DIR [lerobot-train arguments...]: fails wi
   return "$status"
 }
 
-evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the SPLITS of TASK
-  local per_job=$(( ($4 + EVAL_JOBS - 1) / EVAL_JOBS ))
-  tavis eval --policy "$1/pretrained_model" --tasks "$TASK" --splits "${splits[@]}" --episodes "$4" --seed "$3" \
+evaluate() {  # evaluate CHECKPOINT_DIR OUTPUT_DIR FIRST_SEED EPISODES: the SPLITS of TASK (each task of a list)
+  local per_job=$(( ($4 + EVAL_JOBS - 1) / EVAL_JOBS )) tasks
+  IFS=, read -ra tasks <<< "$TASK"
+  tavis eval --policy "$1/pretrained_model" --tasks "${tasks[@]}" --splits "${splits[@]}" --episodes "$4" --seed "$3" \
     --robot "$ROBOT" --camera-mode "$CONDITION" --image-size "$SIZE" --device "$DEVICE" --policy-option "use_amp=$AMP" \
     --workers "$EVAL_JOBS" --chunk-episodes "$per_job" --batch-size $(( per_job < EVAL_BATCH ? per_job : EVAL_BATCH )) \
     --film-episodes "$FILM" "${eval_options[@]}" --out "$2"
@@ -317,7 +323,7 @@ case "${1:-}" in
     record
     if [ -n "${CUDA_VISIBLE_DEVICES:-}" ]; then IFS=, read -ra gpus <<< "$CUDA_VISIBLE_DEVICES"
     else mapfile -t gpus < <(nvidia-smi --query-gpu=index --format=csv,noheader 2>/dev/null || true); fi
-    index=0
+    index=0 cells=()  # background process -> its condition
     for condition in head_wrist fixed_wrist; do
       ( if (( ${#gpus[@]} > 1 )); then  # MuJoCo's EGL follows CUDA_VISIBLE_DEVICES only where the driver maps them
           gpu=${gpus[index % ${#gpus[@]}]}
@@ -325,27 +331,41 @@ case "${1:-}" in
         fi
         CONDITION=$condition WORKERS=$(( WORKERS > 1 ? WORKERS / 2 : 1 )) "$0" cell > "$WORK/cell_$condition.log" 2>&1
       ) &
+      cells[$!]=$condition
       index=$(( index + 1 ))
     done
-    wait
+    failed=0
+    for cell in "${!cells[@]}"; do
+      wait "$cell" || { echo "train_baseline: ${cells[cell]} failed: $WORK/cell_${cells[cell]}.log" >&2; failed=1; }
+    done
+    exit "$failed"
     ;;
   cell)
     "$0" data
     stopped="$WORK/train_$RUN.stopped"
     rm -f "$stopped"
+    if [ "$POLICY" = diffusion ]; then train_s=${TRAIN_S:-1500}; else train_s=${TRAIN_S:-960}; fi
     ( if [ "$ACTIONS" = absolute ]; then  # the hand-frame preset holds its own budget
         export BATCH=${BATCH:-128} SAVE_FREQ=${SAVE_FREQ:-1600} STEPS=${STEPS:-4800}
       fi
-      if [ "$POLICY" = diffusion ]; then train_s=${TRAIN_S:-1500}; else train_s=${TRAIN_S:-960}; fi
-      WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "$train_s" "$0" train || true
-      touch "$stopped" ) &
+      trained=0
+      WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "$train_s" "$0" train || trained=$?
+      echo "$trained" > "$stopped" ) &  # the training's exit status: 124 when TRAIN_S stopped it
     ( while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
         nice -n 15 "$0" eval
         for _ in {1..10}; do [ -f "$stopped" ] || sleep 1; done  # a look every 10 s while training goes on
       done ) &
     while [ ! -f "$stopped" ]; do sleep 1; done
-    "$0" eval  # the checkpoints left, side by side with the one still being evaluated
+    failed=0
+    "$0" eval || failed=1  # the checkpoints left, side by side with the one still being evaluated
     wait
+    trained=$(cat "$stopped")
+    if (( trained != 0 )); then  # what it saved is evaluated all the same
+      echo "train_baseline: the training of $RUN stopped with status $trained$( (( trained == 124 )) \
+        && echo " (TRAIN_S, $train_s s, reached)") (its output above)" >&2
+      exit 1
+    fi
+    exit "$failed"
     ;;
   data)
     record
@@ -373,7 +393,7 @@ case "${1:-}" in
     ;;
   eval)  # every complete checkpoint (up to the one `last` points at), so it may run while training goes on
     link=$(readlink "$WORK/train_$RUN/checkpoints/last") 2>/dev/null || exit 0  # no checkpoint yet
-    last=$(basename "$link")
+    last=$(basename "$link") evaluations=()
     for checkpoint in "$WORK/train_$RUN"/checkpoints/[0-9]*; do
       (( 10#$(basename "$checkpoint") <= 10#$last )) || continue
       case "$CHECKPOINTS" in
@@ -386,11 +406,14 @@ case "${1:-}" in
       mkdir -p "$(dirname "$out")"
       mkdir "$out.running" 2>/dev/null || continue  # another eval call has it
       ( trap 'rmdir "$out.running"' EXIT; time evaluate "$checkpoint" "$out" 1000 "$EVAL_EPISODES" ) &
+      evaluations+=($!)
     done
-    wait
+    failed=0
+    for evaluation in "${evaluations[@]}"; do wait "$evaluation" || failed=1; done
     if compgen -G "$WORK/$EVAL_NAME/step_*/results.json" > /dev/null; then
       tavis curve "$WORK/$EVAL_NAME"  # success by training step over every checkpoint evaluated so far
     fi
+    if (( failed )); then echo "train_baseline: an evaluation of $RUN failed (its output above)" >&2; exit 1; fi
     ;;
   overfit)
     choose_video_backend

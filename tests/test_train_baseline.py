@@ -18,13 +18,14 @@ LOG_CALL = 'echo "$(basename "$0") $* | gpu=${CUDA_VISIBLE_DEVICES:-} egl=${MUJO
 TAVIS = LOG_CALL + """case $1 in
   record) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/manifest.json" ;;
   presets) echo "${PRESET_FILE:-/dev/null}" ;;
-  eval) out=${@: -1}; mkdir -p "$out"; echo '{}' > "$out/results.json" ;;
+  eval) out=${@: -1}; [ -z "${EVAL_FAILS:-}" ] || exit 1; mkdir -p "$out"; echo '{}' > "$out/results.json" ;;
   noise-state) mkdir -p "$4/meta"  # noise-state SOURCE --out OUT --position-m P --rotation-deg R --seed S
     printf '{"position_m": %s, "rotation_deg": %s, "seed": %s}' "$6" "$8" "${10}" > "$4/meta/state_noise.json" ;;
 esac
 """
 LEROBOT_TRAIN = LOG_CALL + """for arg in "$@"; do case $arg in --output_dir=*) out=${arg#*=} ;; esac; done
 for step in 001500 003000; do mkdir -p "$out/checkpoints/$step"; ln -sfn $step "$out/checkpoints/last"; done
+exit "${TRAIN_STATUS:-0}"
 """
 
 
@@ -63,6 +64,31 @@ def test_pair_trains_each_condition_on_its_own_visible_gpu_and_evaluates_every_c
     assert all("--tasks conditional_pick --splits id --episodes 96" in call for call in calls if "tavis eval" in call)
     curves = {call.split(" | ")[0] for call in calls if call.startswith("tavis curve")}
     assert curves == {f"tavis curve {work}/eval_{condition}" for condition in ("fixed_wrist", "head_wrist")}
+
+
+def test_a_task_list_is_recorded_trained_and_evaluated_as_one_multi_task_cell(tmp_path):
+    calls = _run(tmp_path, "cell", TASK="peeking_box,occluded_reach")
+    assert [call.split(" --episodes-per-task")[0] for call in calls if call.startswith("tavis record")] == [
+        "tavis record --robot gr1t2 --tasks peeking_box,occluded_reach"]
+    assert all("--env.task=peeking_box,occluded_reach " in call for call in calls if call.startswith("lerobot-train"))
+    evals = [call for call in calls if call.startswith("tavis eval")]
+    assert len(evals) == 2 and all("--tasks peeking_box occluded_reach --splits id" in call for call in evals)
+
+
+@pytest.mark.parametrize(("mode", "settings", "message"), [
+    ("cell", {"EVAL_FAILS": "1"}, "train_baseline: an evaluation of head_wrist failed"),
+    ("cell", {"TRAIN_STATUS": "3"}, "train_baseline: the training of head_wrist stopped with status 3"),
+    ("eval", {"EVAL_FAILS": "1"}, "train_baseline: an evaluation of head_wrist failed"),
+    ("pair", {"EVAL_FAILS": "1"}, "train_baseline: head_wrist failed: "),
+])
+def test_a_failed_training_or_evaluation_fails_the_command_with_a_message(tmp_path, mode, settings, message):
+    if mode == "eval":  # a checkpoint to evaluate
+        _run(tmp_path / "trained", "train", WORK=str(tmp_path / "work"))
+    failed = _stubbed(tmp_path, mode, **settings)
+    assert failed.returncode == 1 and message in failed.stderr
+    if mode == "cell" and "TRAIN_STATUS" in settings:  # what the training saved is evaluated all the same
+        assert len([call for call in (tmp_path / "calls.log").read_text().splitlines()
+                    if call.startswith("tavis eval")]) == 2
 
 
 def test_eval_options_reach_tavis_eval_and_its_folder_is_eval_name(tmp_path):
