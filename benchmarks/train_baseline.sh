@@ -59,7 +59,9 @@
 #   fails when either condition's `cell` does, naming its log.
 # - data: records the demonstrations once (both conditions share them) and converts them at 120x160 with the
 #   condition's cameras (`--zero-neck` for fixed_wrist, as its env holds the neck at 0), unless WORK already holds
-#   that conversion of that recording (its meta/tavis_conversion.json says so): then the dataset is kept.
+#   that conversion of that recording (its meta/tavis_conversion.json says so): then the dataset is kept. A recording
+#   of several tasks is converted task by task side by side, WORKERS shared, and merged with `lerobot-edit-dataset`
+#   (the samples of one conversion, docs/datasets.md; one conversion's single writer bounds it).
 # - prepare: data, then (FRAME_CACHE=on) the dataset's frame cache: the CPU work `train` needs done, which can run
 #   ahead while another cell trains.
 # - train: lerobot-train with the `act_<CONDITION>_compact` preset (ACTIONS=hand_relative:
@@ -224,9 +226,39 @@ sys.exit(0 if same else 1)
 PY
 }
 
-convert() {  # convert RAW_DIR DATASET_DIR
+convert() {  # convert RAW_DIR DATASET_DIR; a recording of several tasks is converted task by task side by side
+  # (one writer bounds a conversion) and merged by LeRobot, which gives the samples of one conversion (datasets.md)
+  local tasks parts="$2.parts" part merging="$2.merging" status=0
+  mapfile -t tasks < <(python3 -c 'import json, sys
+from lerobot_tavis.envs.tasks.catalog import task_sort_key
+episodes = json.load(open(sys.argv[1] + "/manifest.json"))["episodes"]
+print(*sorted({episode["task"] for episode in episodes}, key=task_sort_key), sep="\n")' "$1")
+  if (( ${#tasks[@]} < 2 )); then convert_tasks "$1" "$2" "$WORKERS"; return; fi
+  rm -rf "$parts" "$merging"
+  for part in "${tasks[@]}"; do
+    convert_tasks "$1" "$parts/$part" $(( WORKERS / ${#tasks[@]} > 1 ? WORKERS / ${#tasks[@]} : 1 )) --task "$part" &
+  done
+  for part in "${tasks[@]}"; do wait -n || status=$?; done
+  (( status == 0 )) || return "$status"
+  lerobot-edit-dataset --new_repo_id "local/$(basename "$2")" --new_root "$merging" --operation.type merge \
+    --operation.repo_ids "$(python3 -c 'import sys; print([f"local/{task}" for task in sys.argv[1:]])' "${tasks[@]}")" \
+    --operation.roots "$(python3 -c 'import sys; print(sys.argv[1:])' "${tasks[@]/#/$parts/}")"
+  python3 - "$merging" "${tasks[@]/#/$parts/}" <<'PY'  # the merged dataset's conversion log: its parts', in order
+import json, sys
+merged, parts = sys.argv[1], sys.argv[2:]
+logs = [json.load(open(f"{part}/meta/tavis_conversion.json")) for part in parts]
+log = {key: value for key, value in logs[0].items() if key != "episodes"}
+assert all({key: value for key, value in other.items() if key != "episodes"} == log for other in logs), parts
+episodes = (episode for part in logs for episode in part["episodes"])
+log["episodes"] = [dict(episode, episode_index=index) for index, episode in enumerate(episodes)]
+json.dump(log, open(f"{merged}/meta/tavis_conversion.json", "w"), indent=1)
+PY
+  rm -rf "$2" && mv "$merging" "$2" && rm -rf "$parts"
+}
+
+convert_tasks() {  # convert_tasks RAW_DIR DATASET_DIR WORKERS [--task TASK]
   tavis convert "$1" --repo-id "local/$(basename "$2")" --root "$2" --fps 20 --image-size "$SIZE" \
-    --cameras "$CAMERAS" "${NECK[@]}" --workers "$WORKERS" --overwrite
+    --cameras "$CAMERAS" "${NECK[@]}" --workers "$3" --overwrite "${@:4}"
 }
 
 # Copies its input to its output as it comes; at the first NaN loss in LeRobot's log lines it stops the processes

@@ -259,6 +259,70 @@ def test_state_noise_with_state_input_off_is_refused(tmp_path):
     assert not (tmp_path / "calls.log").exists()
 
 
+# `tavis record` writes a recording of two tasks (occluded_reach listed first), `tavis convert` the conversion log of
+# its --task's episodes after half a second (its start and end logged), `lerobot-edit-dataset` the merged folder.
+MULTI_TASK_TAVIS = """echo "tavis $*" >> "$CALLS"
+case $1 in
+  record) out=${@: -1}; mkdir -p "$out"; echo '{"episodes": [{"task": "occluded_reach", "file": "o0.npz"},
+    {"task": "peeking_box", "file": "p0.npz"}, {"task": "peeking_box", "file": "p1.npz"}]}' > "$out/manifest.json" ;;
+  convert) echo "start ${@: -1}" >> "$CALLS"; sleep 0.5
+    "$PYTHON" - "$@" <<'PY'
+import json, os, sys
+raw, args = sys.argv[2], sys.argv[3:]
+value = lambda flag: args[args.index(flag) + 1]
+episodes = [e for e in json.load(open(os.path.join(raw, "manifest.json")))["episodes"] if e["task"] == value("--task")]
+log = {"raw_dir": os.path.abspath(raw), "fps": int(value("--fps")),
+       "image_size": [int(n) for n in value("--image-size").split("x")], "cameras": value("--cameras").split(","),
+       "zero_neck": "--zero-neck" in args,
+       "episodes": [{"episode_index": i, "raw_file": e["file"], "task": e["task"]} for i, e in enumerate(episodes)]}
+os.makedirs(os.path.join(value("--root"), "meta"))
+json.dump(log, open(os.path.join(value("--root"), "meta", "tavis_conversion.json"), "w"))
+PY
+    echo "end ${@: -1}" >> "$CALLS" ;;
+esac
+"""
+EDIT_DATASET = """echo "lerobot-edit-dataset $*" >> "$CALLS"
+for arg in "$@"; do [ "${previous:-}" = --new_root ] && mkdir -p "$arg/meta"; previous=$arg; done
+"""
+
+
+def test_a_recording_of_several_tasks_is_converted_task_by_task_side_by_side_and_merged(tmp_path):
+    import sys
+
+    stubs = tmp_path / "bin"
+    stubs.mkdir()
+    for name, body in (("tavis", MULTI_TASK_TAVIS), ("lerobot-edit-dataset", EDIT_DATASET)):
+        (stubs / name).write_text("#!/usr/bin/env bash\n" + body)
+        (stubs / name).chmod(0o755)
+    calls, work = tmp_path / "calls.log", tmp_path / "work"
+    env = {**os.environ, "PATH": f"{stubs}:{os.path.dirname(sys.executable)}:{os.environ['PATH']}",
+           "CALLS": str(calls), "PYTHON": sys.executable, "WORK": str(work), "WORKERS": "4",
+           "TASK": "peeking_box,occluded_reach"}
+    data = subprocess.run(["bash", str(SCRIPT), "data"], env=env, capture_output=True, text=True, timeout=60)
+    assert data.returncode == 0, data.stderr
+    log = calls.read_text().splitlines()
+    converts = sorted(call for call in log if call.startswith("tavis convert"))
+    dataset, parts = work / "dataset_head_wrist", f"{work}/dataset_head_wrist.parts"
+    assert [call.split(" --root ")[1].split()[0] for call in converts] == [f"{parts}/occluded_reach",
+                                                                         f"{parts}/peeking_box"]
+    assert all(" --workers 2 --overwrite --task " in call for call in converts)  # the cores shared
+    events = [call.split()[0] for call in log if call.startswith(("start ", "end "))]
+    assert events == ["start", "start", "end", "end"]  # side by side
+    (merge,) = [call for call in log if call.startswith("lerobot-edit-dataset")]
+    assert (f"--new_repo_id local/dataset_head_wrist --new_root {dataset}.merging --operation.type merge "
+            f"--operation.repo_ids ['local/peeking_box', 'local/occluded_reach'] "
+            f"--operation.roots ['{parts}/peeking_box', '{parts}/occluded_reach']") in merge  # in catalog order
+    merged = json.loads((dataset / "meta" / "tavis_conversion.json").read_text())
+    assert [(e["episode_index"], e["raw_file"]) for e in merged["episodes"]] == [(0, "p0.npz"), (1, "p1.npz"),
+                                                                                 (2, "o0.npz")]
+    assert merged["raw_dir"] == str(work / "raw") and merged["cameras"] == ["head", "left_wrist", "right_wrist"]
+    assert sorted(path.name for path in work.iterdir()) == ["dataset_head_wrist", "raw"]  # no parts left
+    calls.unlink()
+    again = subprocess.run(["bash", str(SCRIPT), "data"], env=env, capture_output=True, text=True, timeout=60)
+    assert again.returncode == 0 and "holds this recording's conversion: kept" in again.stdout
+    assert not calls.exists()  # nothing converted or merged again
+
+
 def test_a_nan_loss_stops_the_training_run_and_fails_with_a_clear_message(tmp_path):
     stubs = tmp_path / "bin"
     stubs.mkdir()
