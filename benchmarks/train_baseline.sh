@@ -382,7 +382,7 @@ case "${1:-}" in
       fi
       trained=0
       WORKERS=$(( WORKERS > 4 ? WORKERS - 2 : WORKERS )) timeout -s TERM "$train_s" "$0" train || trained=$?
-      echo "$trained" > "$stopped" ) &  # the training's exit status: 124 when TRAIN_S stopped it
+      echo "$trained" > "$stopped.tmp" && mv "$stopped.tmp" "$stopped" ) &  # its exit status; 124: TRAIN_S stopped it
     ( while [ ! -f "$stopped" ]; do  # training keeps the cores: evaluations take what it leaves
         nice -n 15 "$0" eval
         for _ in {1..10}; do [ -f "$stopped" ] || sleep 1; done  # a look every 10 s while training goes on
