@@ -5,6 +5,7 @@ import json
 import os
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -287,8 +288,6 @@ for arg in "$@"; do [ "${previous:-}" = --new_root ] && mkdir -p "$arg/meta"; pr
 
 
 def test_a_recording_of_several_tasks_is_converted_task_by_task_side_by_side_and_merged(tmp_path):
-    import sys
-
     stubs = tmp_path / "bin"
     stubs.mkdir()
     for name, body in (("tavis", MULTI_TASK_TAVIS), ("lerobot-edit-dataset", EDIT_DATASET)):
