@@ -1,5 +1,6 @@
 """benchmarks/train_baseline.sh's orchestration, run with stand-ins for tavis and lerobot-train that record how
-they were called: which GPU each condition gets, and that every checkpoint is evaluated once."""
+they were called: which GPU each condition gets, that every checkpoint is evaluated once, that a failed training or
+evaluation fails the command, and how a list of tasks is converted (side by side, then merged) and evaluated."""
 
 import json
 import os
